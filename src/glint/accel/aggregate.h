@@ -1,0 +1,50 @@
+// The frozen collection of primitives with its two queries: closest hit, and shadow transmittance.
+// Bounded primitives go into a bounding volume hierarchy (binned SAH build, flattened nodes,
+// near-child-first traversal); unbounded ones (planes, tubes) are tested on every ray.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "glint/core/color.h"
+#include "glint/core/ray.h"
+#include "glint/geometry/shape.h"
+
+namespace glint {
+
+struct Hit {
+  double t = 0;                 // ray parameter
+  Normal3 normal;               // unit geometric world-space normal, as the shape defines it
+  std::uint32_t primitive = 0;  // index into the primitives passed to the Aggregate
+};
+
+class Aggregate {
+ public:
+  // primitiveTransmission[i] is the factor a shadow ray keeps each time it crosses primitive i
+  // (the material's kt); same size as primitives.
+  Aggregate(std::vector<Primitive> primitives, std::vector<Color> primitiveTransmission);
+
+  // Closest hit with tMin < t < tMax.
+  bool intersect(const Ray& ray, double tMin, double tMax, Hit& hit) const;
+  // Product of kt over every surface crossing in (tMin, tMax); stops early once it is black.
+  Color transmittance(const Ray& ray, double tMin, double tMax) const;
+
+  const std::vector<Primitive>& primitives() const { return primitives_; }
+  Bounds3 bounds() const { return bounds_; }  // of the bounded primitives
+
+ private:
+  struct Node {
+    Bounds3 bounds;
+    std::uint32_t offset = 0;  // leaf: first index into order_; inner: index of the second child
+    std::uint16_t count = 0;   // leaf: number of primitives; 0 for inner nodes
+    std::uint8_t axis = 0;     // inner: split axis (the first child is on the low side)
+  };
+  std::vector<Primitive> primitives_;
+  std::vector<Color> transmission_;
+  std::vector<std::uint32_t> order_;      // bounded primitive indices in leaf order
+  std::vector<std::uint32_t> unbounded_;  // primitives tested on every ray
+  std::vector<Node> nodes_;               // depth-first; the first child follows its parent
+  Bounds3 bounds_;
+};
+
+}  // namespace glint

@@ -1,0 +1,190 @@
+// The closed set of analytic shapes (the seed's Geometry family and DESIGN.md §5), dispatched through
+// std::variant: no virtual call and no allocation per ray.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <variant>
+#include <vector>
+
+#include "glint/core/bounds.h"
+#include "glint/core/color.h"
+#include "glint/core/ray.h"
+#include "glint/core/transform.h"
+#include "glint/core/vec.h"
+
+namespace glint {
+
+// Thrown when a shape is built from invalid parameters; what() says why, e.g.
+// "radius must be > 0, got -2". The scene builder adds file:line:col.
+class ShapeError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+// Closest-hit result of one shape, in the space of the ray that was passed in.
+struct ShapeHit {
+  double t = 0;    // ray parameter of the hit, tMin < t < tMax
+  Normal3 normal;  // unit geometric normal as the shape defines it (never flipped toward the ray)
+};
+
+// Conventions shared by every shape below:
+// - intersect(ray, tMin, tMax, hit): closest hit with tMin < t < tMax (both bounds exclusive), for any
+//   non-zero ray direction. A ray that starts exactly on the surface and leaves it does not hit it at
+//   t = 0; a tangent ray (touching at a single point) misses; a ray parallel to a flat shape misses.
+// - crossings(ray, tMin, tMax): how many times the ray crosses the surface in (tMin, tMax) — used for
+//   shadow transmittance, where a transparent sphere in the way counts twice.
+// - bounds(): world-space box; unbounded shapes (plane, tube) return Bounds3::unbounded().
+// - normalAt(p): unit geometric normal at a point p on the surface (the seed's getNormal).
+// - Closed shapes (sphere, tube, cylinder, box) have outward normals; flat shapes have the normal of
+//   their definition (plane, disk: as given; triangle, polygon, quadrangle: (v1−v0)×(v2−v0) by the
+//   right-hand rule over the vertex order; rectangle: edge0 × edge1).
+// - Each shape has a static make(...) factory that validates its parameters and throws ShapeError.
+
+struct Sphere {
+  Point3 center;
+  double radius = 1;
+  static Sphere make(const Point3& center, double radius);
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+};
+
+// Infinite plane through `point` with unit `normal`.
+struct Plane {
+  Point3 point;
+  Normal3 normal;
+  static Plane make(const Point3& point, const Vec3& normal);
+  // Plane through three non-collinear points; normal (b−a)×(c−a).
+  static Plane fromPoints(const Point3& a, const Point3& b, const Point3& c);
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+};
+
+// Triangle with the watertight ray–triangle test of Woop, Benthin and Wald (2013): rays through a
+// shared edge or vertex hit one of the triangles sharing it and never slip between them.
+struct Triangle {
+  Point3 v0, v1, v2;
+  Normal3 normal;  // unit, (v1−v0)×(v2−v0)
+  static Triangle make(const Point3& v0, const Point3& v1, const Point3& v2);  // rejects collinear
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+};
+
+// Planar convex polygon with ≥ 3 vertices in order (either winding).
+struct Polygon {
+  std::vector<Point3> vertices;
+  Normal3 normal;  // unit, by the right-hand rule over the vertex order
+  static Polygon make(std::vector<Point3> vertices);  // rejects non-planar, non-convex, degenerate
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+};
+
+// Rectangle: corner + s·edge0 + t·edge1 for s, t in [0, 1]; the edges must be perpendicular.
+struct Rectangle {
+  Point3 corner;
+  Vec3 edge0, edge1;
+  Normal3 normal;  // unit, edge0 × edge1
+  static Rectangle make(const Point3& corner, const Vec3& edge0, const Vec3& edge1);
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+};
+
+// Planar quadrangle v0 v1 v2 v3 (in order, simple, need not be convex), split into two triangles
+// along a diagonal that lies inside it.
+struct Quadrangle {
+  Triangle first, second;
+  Normal3 normal;  // unit, by the right-hand rule over the vertex order
+  static Quadrangle make(const Point3& v0, const Point3& v1, const Point3& v2, const Point3& v3);
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+};
+
+// Infinite cylinder of `radius` around the line origin + s·axis (axis unit).
+struct Tube {
+  Point3 origin;
+  Vec3 axis;
+  double radius = 1;
+  static Tube make(const Point3& origin, const Vec3& axis, double radius);
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+};
+
+// Capped cylinder from `base` along unit `axis` for `height`; cap normals −axis at the base and
+// +axis at the top, side normals radial.
+struct Cylinder {
+  Point3 base;
+  Vec3 axis;
+  double radius = 1;
+  double height = 1;
+  static Cylinder make(const Point3& base, const Vec3& axis, double radius, double height);
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+};
+
+// Axis-aligned box [lo, hi] with outward face normals (any box through `transform`).
+struct Box {
+  Point3 lo, hi;
+  static Box make(const Point3& lo, const Point3& hi);  // requires lo < hi on every axis
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+};
+
+// Flat disk of `radius` around `center`, facing unit `normal`.
+struct Disk {
+  Point3 center;
+  Normal3 normal;
+  double radius = 1;
+  static Disk make(const Point3& center, const Vec3& normal, double radius);
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+};
+
+using Shape = std::variant<Sphere, Plane, Triangle, Polygon, Rectangle, Quadrangle, Tube, Cylinder,
+                           Box, Disk>;
+
+// A shape placed in the world, optionally through an affine transform (worldFromObject), with what
+// the renderer needs to shade it. The seed's Geometry: shape + material + emission colour.
+class Primitive {
+ public:
+  Primitive(Shape shape, std::uint32_t materialIndex, const Color& emission,
+            std::optional<Transform> worldFromObject = std::nullopt);
+
+  // World-space closest hit; the normal is transformed to world space and normalised.
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const { return bounds_; }
+  bool isBounded() const { return bounds_.isBounded(); }
+  const Shape& shape() const { return shape_; }
+  std::uint32_t materialIndex() const { return materialIndex_; }
+  const Color& emission() const { return emission_; }
+
+ private:
+  Shape shape_;
+  std::optional<Transform> worldFromObject_;
+  std::uint32_t materialIndex_ = 0;
+  Color emission_;
+  Bounds3 bounds_;
+};
+
+}  // namespace glint

@@ -1,0 +1,30 @@
+// Scene files (DESIGN.md §5): YAML/JSON text → SceneDescription (plain data with the file:line:col of
+// every entity; io/scene_description.h) → SceneParts (render objects; scene/scene.h). Strict: an
+// unknown key, a wrong type, a missing required key or an invalid value is an error naming its place.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "glint/io/diagnostics.h"
+#include "glint/scene/scene.h"
+
+namespace glint {
+
+struct LoadedScene {
+  SceneParts parts;
+  std::vector<Diagnostic> warnings;
+};
+
+// Reads, parses and builds a scene file. Throws SceneError carrying every error found (up to 20);
+// a missing, unreadable or directory path is an error naming only the file.
+LoadedScene loadScene(const std::filesystem::path& file);
+
+// The same for text in memory. `displayName` names the text in messages; relative paths inside it
+// (mesh files) resolve from `baseDirectory`.
+LoadedScene loadSceneFromString(std::string_view text, const std::string& displayName,
+                                const std::filesystem::path& baseDirectory = ".");
+
+}  // namespace glint

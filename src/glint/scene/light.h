@@ -1,0 +1,54 @@
+// Light sources of DESIGN.md §3 (the seed's LightSource family): directional, point and spot.
+// Ambient light is a scene property (Scene::ambient). Closed set: std::variant, no virtual calls.
+#pragma once
+
+#include <variant>
+
+#include "glint/core/color.h"
+#include "glint/core/vec.h"
+
+namespace glint {
+
+// Distance attenuation 1 / (kc + kl·d + kq·d²); components ≥ 0 and not all 0.
+struct Attenuation {
+  double kc = 1;
+  double kl = 0;
+  double kq = 0;
+};
+
+// A light at infinity; `direction` (unit) is the way its light travels. No falloff.
+struct DirectionalLight {
+  Vec3 direction;
+  Color intensity;  // color × intensity
+};
+
+// I0 / (kc + kl·d + kq·d²).
+struct PointLight {
+  Point3 position;
+  Color intensity;  // I0 = color × intensity
+  Attenuation attenuation;
+};
+
+// Point-light falloff × max(0, D·l)^exponent, D = unit `direction` the spot faces.
+struct SpotLight {
+  Point3 position;
+  Vec3 direction;
+  Color intensity;  // I0 = color × intensity
+  Attenuation attenuation;
+  double exponent = 1;
+};
+
+using Light = std::variant<DirectionalLight, PointLight, SpotLight>;
+
+// What a light delivers to a point P.
+struct LightSample {
+  Vec3 toPoint;        // l: unit vector from the light to P
+  double distance = 0; // from P to the light; infinity for directional lights
+  Color intensity;     // I_L(P) before shadowing
+};
+
+// I_L(P) and l for any light (DESIGN.md §3). P at the position of a point/spot light gives zero
+// intensity (l is undefined there).
+LightSample illuminate(const Light& light, const Point3& p);
+
+}  // namespace glint

@@ -1,0 +1,96 @@
+// The frozen scene: primitives in their acceleration structure, materials, lights, camera and the
+// image and render settings. Built once (by code or by io/scene_builder), then only queried (const),
+// shared by all render threads without locks.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "glint/accel/aggregate.h"
+#include "glint/core/color.h"
+#include "glint/scene/camera.h"
+#include "glint/scene/light.h"
+#include "glint/scene/material.h"
+
+namespace glint {
+
+enum class Encoding { Srgb, Linear };
+
+// The seed's printGrid: after rendering, every pixel whose column or row is a multiple of interval
+// (0 included) is painted with color.
+struct GridOverlay {
+  int interval = 100;  // pixels, > 0
+  Color color;         // linear
+};
+
+struct ImageSettings {
+  int width = 1;   // pixels (also given to the camera)
+  int height = 1;
+  int samples = 1;  // per pixel, stratified
+  Encoding encoding = Encoding::Srgb;
+  std::optional<GridOverlay> grid;
+};
+
+struct RenderSettings {
+  int maxDepth = 10;         // surface hits per path, the primary hit included
+  double minWeight = 0.001;  // a branch stops when the product of kr/kt factors falls below this
+  int blurSamples = 16;      // rays per glossy reflection/refraction
+  std::uint64_t seed = 0;    // varies every random number, deterministically
+};
+
+// Everything needed to build a Scene. The scene builder fills this from a scene file; programs may
+// fill it directly. Primitive material indices point into `materials`.
+struct SceneParts {
+  std::string name;
+  std::vector<Primitive> primitives;
+  std::vector<Material> materials{Material{}};  // index 0: the default material
+  std::vector<Light> lights;
+  Color ambient;      // Ia = ambient color × ambient intensity
+  Color background;   // linear; what a ray that misses returns
+  CameraSpec camera;  // imageWidth/imageHeight are overwritten from `image`
+  ImageSettings image;
+  RenderSettings render;
+};
+
+class Scene {
+ public:
+  // Builds the camera and the acceleration structure. Throws CameraError / std::invalid_argument
+  // for an invalid camera or a primitive whose material index is out of range.
+  explicit Scene(SceneParts parts);
+
+  const std::string& name() const { return name_; }
+  const Aggregate& aggregate() const { return aggregate_; }
+  const std::vector<Primitive>& primitives() const { return aggregate_.primitives(); }
+  const std::vector<Material>& materials() const { return materials_; }
+  const Material& materialOf(std::uint32_t primitive) const {
+    return materials_[aggregate_.primitives()[primitive].materialIndex()];
+  }
+  const std::vector<Light>& lights() const { return lights_; }
+  const Color& ambient() const { return ambient_; }
+  const Color& background() const { return background_; }
+  const Camera& camera() const { return camera_; }
+  const ImageSettings& image() const { return image_; }
+  const RenderSettings& render() const { return render_; }
+
+  bool intersect(const Ray& ray, double tMax, Hit& hit) const {
+    return aggregate_.intersect(ray, 0, tMax, hit);
+  }
+  Color transmittance(const Ray& ray, double tMax) const {
+    return aggregate_.transmittance(ray, 0, tMax);
+  }
+
+ private:
+  std::string name_;
+  std::vector<Material> materials_;
+  std::vector<Light> lights_;
+  Color ambient_;
+  Color background_;
+  Camera camera_;
+  ImageSettings image_;
+  RenderSettings render_;
+  Aggregate aggregate_;
+};
+
+}  // namespace glint
