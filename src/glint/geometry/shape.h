@@ -181,7 +181,8 @@ class Primitive {
 
  private:
   Shape shape_;
-  std::optional<Transform> worldFromObject_;
+  std::optional<Transform> worldFromObject_;  // absent: the shape is already in world space
+  Transform objectFromWorld_;                 // inverse of worldFromObject_, used once per ray
   std::uint32_t materialIndex_ = 0;
   Color emission_;
   Bounds3 bounds_;
