@@ -39,6 +39,11 @@ class Aggregate {
     std::uint16_t count = 0;   // leaf: number of primitives; 0 for inner nodes
     std::uint8_t axis = 0;     // inner: split axis (the first child is on the low side)
   };
+  struct BuildItem;  // one bounded primitive during the build (aggregate.cpp)
+  // Appends the subtree over items[begin, end) to nodes_ depth-first (binned SAH, median fallback).
+  void build(std::vector<BuildItem>& items, std::uint32_t begin, std::uint32_t end, int depth);
+  friend struct AggregateInspector;  // aggregate_test.cpp checks the node layout invariants
+
   std::vector<Primitive> primitives_;
   std::vector<Color> transmission_;
   std::vector<std::uint32_t> order_;      // bounded primitive indices in leaf order
