@@ -1,0 +1,380 @@
+#include "glint/render/renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "glint/geometry/shape.h"
+#include "glint/scene/scene.h"
+
+namespace glint {
+namespace {
+
+// Camera at the origin looking down −z (right = +x, up = +y) through a view plane `viewSize` wide
+// and high at distance 1.
+SceneParts baseParts(int width, int height, double viewSize = 2) {
+  SceneParts parts;
+  parts.camera.position = {0, 0, 0};
+  parts.camera.direction = {0, 0, -1};
+  parts.camera.up = {0, 1, 0};
+  parts.camera.viewPlaneWidth = viewSize * width / height;
+  parts.camera.viewPlaneHeight = viewSize;
+  parts.camera.viewPlaneDistance = 1;
+  parts.image.width = width;
+  parts.image.height = height;
+  parts.image.encoding = Encoding::Linear;
+  parts.background = Color(0.1, 0.2, 0.3);
+  return parts;
+}
+
+std::uint32_t addMaterial(SceneParts& parts, const Material& material) {
+  parts.materials.push_back(material);
+  return static_cast<std::uint32_t>(parts.materials.size() - 1);
+}
+
+// A diffuse plane z = -10 facing the camera under a directional light: every point has the same
+// colour kd·I·|n·l|.
+SceneParts litPlaneParts(int width, int height) {
+  SceneParts parts = baseParts(width, height);
+  Material diffuse;
+  diffuse.kd = Color(0.8, 0.6, 0.4);
+  diffuse.ka = Color(0);
+  parts.primitives.emplace_back(Plane::make({0, 0, -10}, {0, 0, 1}), addMaterial(parts, diffuse),
+                                Color{});
+  parts.lights.push_back(DirectionalLight{normalize(Vec3{0.3, 0.2, -1}), Color(1, 1, 1)});
+  return parts;
+}
+
+bool sameFilm(const Film& a, const Film& b) {
+  if (a.region() != b.region()) return false;
+  for (std::size_t i = 0; i < a.pixels().size(); ++i)
+    if (!(a.pixels()[i] == b.pixels()[i])) return false;
+  return true;
+}
+
+TEST(Renderer, RejectsCropOutsideTheImageOrEmpty) {
+  const Scene scene(baseParts(8, 6));
+  for (const PixelRegion& crop :
+       {PixelRegion{-1, 0, 4, 4}, PixelRegion{0, 0, 9, 6}, PixelRegion{0, 0, 8, 7},
+        PixelRegion{3, 2, 3, 5}, PixelRegion{4, 4, 2, 5}}) {
+    RenderOptions options;
+    options.crop = crop;
+    EXPECT_THROW(render(scene, options), std::invalid_argument)
+        << crop.x0 << "," << crop.y0 << "," << crop.x1 << "," << crop.y1;
+  }
+  RenderOptions whole;
+  whole.crop = PixelRegion{0, 0, 8, 6};
+  EXPECT_EQ(render(scene, whole).region(), (PixelRegion{0, 0, 8, 6}));
+}
+
+TEST(Renderer, EmptySceneShowsBackgroundAndCountsCameraRays) {
+  SceneParts parts = baseParts(7, 5);
+  parts.image.samples = 3;
+  const Scene scene(std::move(parts));
+  RenderStats stats;
+  const Film film = render(scene, {}, &stats);
+  ASSERT_EQ(film.width(), 7);
+  ASSERT_EQ(film.height(), 5);
+  for (const Color& c : film.pixels()) {
+    EXPECT_NEAR(c.r, 0.1, 1e-15);
+    EXPECT_NEAR(c.g, 0.2, 1e-15);
+    EXPECT_NEAR(c.b, 0.3, 1e-15);
+  }
+  EXPECT_EQ(stats.rays.camera, 7u * 5u * 3u);
+  EXPECT_EQ(stats.rays.shadow, 0u);
+  EXPECT_EQ(stats.rays.total(), 7u * 5u * 3u);
+  EXPECT_FALSE(stats.cancelled);
+  EXPECT_GE(stats.seconds, 0.0);
+}
+
+TEST(Renderer, CountsOneShadowRayPerLitHit) {
+  SceneParts parts = litPlaneParts(9, 9);
+  parts.image.samples = 4;
+  const Scene scene(std::move(parts));
+  RenderStats stats;
+  render(scene, {}, &stats);
+  EXPECT_EQ(stats.rays.camera, 9u * 9u * 4u);
+  EXPECT_EQ(stats.rays.shadow, 9u * 9u * 4u);
+  EXPECT_EQ(stats.rays.reflection, 0u);
+  EXPECT_EQ(stats.rays.refraction, 0u);
+}
+
+TEST(Renderer, OneSamplePerPixelGoesThroughThePixelCentre) {
+  // A sphere makes the colour depend on the exact ray, so any offset from the centre would show.
+  SceneParts parts = baseParts(11, 9);
+  Material m;
+  m.kd = Color(0.9, 0.7, 0.5);
+  m.ks = Color(0.3);
+  m.shininess = 20;
+  parts.primitives.emplace_back(Sphere::make({0.2, -0.1, -4}, 2.5), addMaterial(parts, m), Color{});
+  parts.lights.push_back(PointLight{{3, 4, 2}, Color(2, 2, 2), {}});
+  const Scene scene(std::move(parts));
+  const Film film = render(scene);
+  for (int row = 0; row < 9; ++row) {
+    for (int column = 0; column < 11; ++column) {
+      Rng rng(0);
+      const Color expected = traceRay(scene, scene.camera().generateRay(column, row), rng);
+      EXPECT_EQ(film.at(column, row), expected) << column << "," << row;
+    }
+  }
+}
+
+TEST(Renderer, SupersamplingAveragesCoverageAtASilhouette) {
+  // A black-on-white edge: an emissive white sphere whose silhouette crosses pixels. With 16
+  // samples some pixel must come out strictly between the two, and every pixel stays within [0, 1].
+  SceneParts parts = baseParts(15, 15);
+  parts.background = Color(0);
+  parts.primitives.emplace_back(Sphere::make({0, 0, -5}, 2), 0u, Color(1, 1, 1));
+  parts.image.samples = 16;
+  const Scene scene(std::move(parts));
+  const Film film = render(scene);
+  int partial = 0;
+  for (const Color& c : film.pixels()) {
+    EXPECT_GE(c.r, 0.0);
+    EXPECT_LE(c.r, 1.0);
+    if (c.r > 0 && c.r < 1) ++partial;
+  }
+  EXPECT_GT(partial, 8);
+  EXPECT_EQ(film.at(7, 7), Color(1, 1, 1));
+  EXPECT_EQ(film.at(0, 0), Color(0, 0, 0));
+}
+
+TEST(Renderer, TileSizeAndThreadCountDoNotChangeThePixels) {
+  SceneParts parts = litPlaneParts(23, 17);
+  Material glossy;
+  glossy.kd = Color(0.2);
+  glossy.kr = Color(0.7);
+  glossy.reflectionBlur = 15;
+  parts.primitives.emplace_back(Sphere::make({0, 0, -6}, 2), addMaterial(parts, glossy), Color{});
+  parts.image.samples = 2;
+  parts.render.blurSamples = 3;
+  const Scene scene(std::move(parts));
+  RenderOptions reference;
+  reference.threads = 1;
+  reference.tileSize = 16;
+  const Film expected = render(scene, reference);
+  for (const int tileSize : {1, 5, 64}) {
+    for (const int threads : {1, 2}) {
+      RenderOptions options;
+      options.threads = threads;
+      options.tileSize = tileSize;
+      EXPECT_TRUE(sameFilm(render(scene, options), expected))
+          << "tile " << tileSize << ", threads " << threads;
+    }
+  }
+}
+
+TEST(Renderer, NonFiniteSamplesBecomeBlackAndAreCounted) {
+  SceneParts parts = baseParts(10, 10);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // A small NaN-emitting square in the middle, seen by the centre 2×2 pixels (pixel pitch 0.2 at
+  // distance 1, so ±0.15 at distance 1 covers the centres ±0.1).
+  parts.primitives.emplace_back(Rectangle::make({-0.15, -0.15, -1}, {0.3, 0, 0}, {0, 0.3, 0}), 0u,
+                                Color(nan, 0, 0));
+  parts.image.samples = 1;
+  const Scene scene(std::move(parts));
+  RenderStats stats;
+  const Film film = render(scene, {}, &stats);
+  EXPECT_EQ(stats.nonFinite, 4u);
+  for (int y = 4; y <= 5; ++y)
+    for (int x = 4; x <= 5; ++x) EXPECT_EQ(film.at(x, y), Color(0, 0, 0)) << x << "," << y;
+  EXPECT_EQ(film.at(0, 0), Color(0.1, 0.2, 0.3));
+}
+
+TEST(Renderer, GridUsesAbsolutePixelCoordinatesInACrop) {
+  SceneParts parts = litPlaneParts(20, 12);
+  parts.image.grid = GridOverlay{4, Color(1, 1, 0)};
+  const Scene scene(std::move(parts));
+  const Film full = render(scene);
+  RenderOptions options;
+  options.crop = PixelRegion{5, 3, 17, 11};
+  const Film crop = render(scene, options);
+  ASSERT_EQ(crop.width(), 12);
+  ASSERT_EQ(crop.height(), 8);
+  int painted = 0;
+  for (int y = 3; y < 11; ++y) {
+    for (int x = 5; x < 17; ++x) {
+      const bool onGrid = x % 4 == 0 || y % 4 == 0;
+      EXPECT_EQ(crop.at(x - 5, y - 3), full.at(x, y)) << x << "," << y;
+      EXPECT_EQ(crop.at(x - 5, y - 3) == Color(1, 1, 0), onGrid) << x << "," << y;
+      painted += onGrid;
+    }
+  }
+  EXPECT_GT(painted, 0);
+  EXPECT_EQ(full.at(0, 0), Color(1, 1, 0));  // 0 is a multiple of the interval
+  EXPECT_NE(full.at(1, 1), Color(1, 1, 0));
+}
+
+TEST(Renderer, ReportsProgressOncePerTileInOrder) {
+  const Scene scene(litPlaneParts(37, 21));
+  RenderOptions options;
+  options.tileSize = 8;
+  options.threads = 2;
+  std::vector<std::size_t> done;
+  std::size_t reportedTotal = 0;
+  options.progress = [&](std::size_t d, std::size_t total) {
+    done.push_back(d);
+    reportedTotal = total;
+  };
+  render(scene, options);
+  const std::size_t tiles = 5 * 3;  // ⌈37/8⌉ × ⌈21/8⌉
+  EXPECT_EQ(reportedTotal, tiles);
+  ASSERT_EQ(done.size(), tiles);
+  for (std::size_t i = 0; i < tiles; ++i) EXPECT_EQ(done[i], i + 1);
+}
+
+TEST(Renderer, CancelStopsBeforeTheRemainingTiles) {
+  const Scene scene(litPlaneParts(32, 32));
+  {
+    const std::atomic<bool> cancel{true};
+    RenderOptions options;
+    options.cancel = &cancel;
+    std::size_t calls = 0;
+    options.progress = [&](std::size_t, std::size_t) { ++calls; };
+    RenderStats stats;
+    render(scene, options, &stats);
+    EXPECT_TRUE(stats.cancelled);
+    EXPECT_EQ(calls, 0u);
+    EXPECT_EQ(stats.rays.camera, 0u);
+  }
+  {
+    std::atomic<bool> cancel{false};
+    RenderOptions options;
+    options.cancel = &cancel;
+    options.threads = 1;
+    options.tileSize = 8;
+    std::size_t calls = 0;
+    options.progress = [&](std::size_t, std::size_t) {
+      ++calls;
+      cancel = true;
+    };
+    RenderStats stats;
+    render(scene, options, &stats);
+    EXPECT_TRUE(stats.cancelled);
+    EXPECT_EQ(calls, 1u);
+    EXPECT_EQ(stats.rays.camera, 8u * 8u);
+  }
+}
+
+// Two facing mirrors z = -5 (normal +z) and z = +5 (normal −z) around the camera.
+SceneParts facingMirrors(const Material& mirror) {
+  SceneParts parts = baseParts(3, 3);
+  const std::uint32_t m = addMaterial(parts, mirror);
+  parts.primitives.emplace_back(Plane::make({0, 0, -5}, {0, 0, 1}), m, Color{});
+  parts.primitives.emplace_back(Plane::make({0, 0, 5}, {0, 0, -1}), m, Color{});
+  return parts;
+}
+
+TEST(Renderer, PrimaryHitIsDepthOne) {
+  Material mirror;
+  mirror.kr = Color(0.5);
+  for (const int maxDepth : {1, 2, 4}) {
+    SceneParts parts = facingMirrors(mirror);
+    parts.render.maxDepth = maxDepth;
+    parts.render.minWeight = 0;
+    const Scene scene(std::move(parts));
+    RayCounts counts;
+    Rng rng(1);
+    traceRay(scene, Ray{{0, 0, 0}, {0, 0, -1}}, rng, &counts);
+    EXPECT_EQ(counts.camera, 1u);
+    EXPECT_EQ(counts.reflection, static_cast<std::uint64_t>(maxDepth - 1));
+  }
+}
+
+TEST(Renderer, GlossySplitsOnceThenUsesOneRayPerBounce) {
+  // Hits: mirror A (depth 1) fans out into N glossy rays; each reaches mirror B (depth 2), where
+  // the already-split path traces 1 cone ray back to A (depth 3 = max_depth, no further rays).
+  Material glossy;
+  glossy.kr = Color(0.9);
+  glossy.reflectionBlur = 2;  // narrow: no sample is dropped at normal incidence
+  SceneParts parts = facingMirrors(glossy);
+  parts.render.maxDepth = 3;
+  parts.render.blurSamples = 6;
+  const Scene scene(std::move(parts));
+  RayCounts counts;
+  Rng rng(7);
+  traceRay(scene, Ray{{0, 0, 0}, {0, 0, -1}}, rng, &counts);
+  EXPECT_EQ(counts.reflection, 6u + 6u);
+  EXPECT_EQ(counts.refraction, 0u);
+}
+
+TEST(Renderer, GlossyReflectionDropsRaysBelowTheSurface) {
+  // A wide glossy mirror floor (y = 0, normal +y) seen at 45°: much of an 80° cone around the ideal
+  // reflection points below the floor. Above the floor everything is a white emissive dome; below
+  // it a red plane. Dropped samples never reach the red plane, so the result is exactly kr · white.
+  SceneParts parts = baseParts(3, 3);
+  Material glossy;
+  glossy.kr = Color(0.5, 0.25, 1);
+  glossy.ka = Color(0);
+  glossy.reflectionBlur = 80;
+  parts.primitives.emplace_back(Plane::make({0, 0, 0}, {0, 1, 0}), addMaterial(parts, glossy),
+                                Color{});
+  parts.primitives.emplace_back(Sphere::make({0, 0, 0}, 1000), 0u, Color(1, 1, 1));
+  parts.primitives.emplace_back(Plane::make({0, -1, 0}, {0, 1, 0}), 0u, Color(1, 0, 0));
+  parts.render.blurSamples = 64;
+  const Scene scene(std::move(parts));
+  for (std::uint64_t key = 0; key < 8; ++key) {
+    Rng rng(key);
+    RayCounts counts;
+    const Color c = traceRay(scene, Ray{{0, 1, 0}, normalize(Vec3{1, -1, 0})}, rng, &counts);
+    EXPECT_EQ(c, Color(0.5, 0.25, 1)) << key;
+    // Roughly a third of the cone lies below the floor: some must have been dropped.
+    EXPECT_LT(counts.reflection, 64u) << key;
+    EXPECT_GT(counts.reflection, 0u) << key;
+  }
+}
+
+TEST(Renderer, GlossySamplingIsKeyedByTheRng) {
+  // A glossy mirror reflecting a diffuse wall lit by a point light: the wall's colour varies
+  // continuously with position, so the average over the cone depends on the exact samples.
+  SceneParts parts = baseParts(3, 3);
+  Material glossy;
+  glossy.kr = Color(1);
+  glossy.ka = Color(0);
+  glossy.reflectionBlur = 30;
+  Material wall;
+  wall.kd = Color(0.8);
+  wall.ka = Color(0);
+  parts.primitives.emplace_back(Plane::make({0, 0, -5}, {0, 0, 1}), addMaterial(parts, glossy),
+                                Color{});
+  parts.primitives.emplace_back(Plane::make({0, 0, 5}, {0, 0, -1}), addMaterial(parts, wall),
+                                Color{});
+  parts.lights.push_back(PointLight{{0.5, 0.5, 0}, Color(10, 10, 10), {1, 0, 0.05}});
+  parts.render.blurSamples = 5;
+  const Scene scene(std::move(parts));
+  const Ray ray{{0, 0, 0}, {0, 0, -1}};
+  Rng a1(11), a2(11), b(12);
+  const Color first = traceRay(scene, ray, a1);
+  EXPECT_GT(first.r, 0.0);
+  EXPECT_EQ(traceRay(scene, ray, a2), first);
+  EXPECT_NE(traceRay(scene, ray, b), first);
+}
+
+TEST(Renderer, TransmissionWithIorOneGoesStraightThrough) {
+  // A kt = 0.5 pane (z = -1) in front of a blue emissive rectangle that only the straight
+  // continuation of the ray reaches (x in [2, 4] at z = -3; the ray crosses z = -3 at x = 3).
+  SceneParts parts = baseParts(3, 3);
+  Material pane;
+  pane.kt = Color(0.5);
+  pane.ka = Color(0);
+  parts.primitives.emplace_back(Plane::make({0, 0, -1}, {0, 0, 1}), addMaterial(parts, pane),
+                                Color{});
+  parts.primitives.emplace_back(Rectangle::make({2, -1, -3}, {2, 0, 0}, {0, 2, 0}), 0u,
+                                Color(0, 0, 1));
+  const Scene scene(std::move(parts));
+  RayCounts counts;
+  Rng rng(0);
+  const Color c = traceRay(scene, Ray{{0, 0, 0}, normalize(Vec3{1, 0, -1})}, rng, &counts);
+  EXPECT_EQ(c, Color(0, 0, 0.5));
+  EXPECT_EQ(counts.refraction, 1u);
+  EXPECT_EQ(counts.reflection, 0u);
+}
+
+}  // namespace
+}  // namespace glint
