@@ -1,0 +1,32 @@
+// The scene builder: SceneDescription → SceneParts (DESIGN.md §5, §7). Checks value ranges,
+// resolves material names, decodes colours under the image encoding, normalises directions,
+// composes transforms and creates the shapes through their make() factories, reporting every
+// problem at the place in the file it comes from. The only io code that creates render objects.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "glint/io/diagnostics.h"
+#include "glint/io/scene_description.h"
+#include "glint/io/scene_limits.h"
+#include "glint/scene/scene.h"
+
+namespace glint {
+
+struct BuildOptions {
+  // Largest film (width · height · sizeof(Color) bytes) the image may ask for.
+  std::uint64_t imageMemoryBudget = defaultImageMemoryBudget();
+};
+
+struct BuildResult {
+  SceneParts parts;                     // complete only when there is no error
+  std::vector<Diagnostic> diagnostics;  // errors and warnings, in the order they were found
+  bool hasErrors() const;
+};
+
+// Builds whatever the description holds. Required parts that are absent are reported only for
+// entities the parser marked complete (the parser has already reported the others).
+BuildResult buildScene(const SceneDescription& description, const BuildOptions& options = {});
+
+}  // namespace glint

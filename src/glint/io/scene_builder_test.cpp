@@ -1,0 +1,570 @@
+// Scene building (DESIGN.md §5, §7): SceneDescription → SceneParts values, colour decoding under
+// both encodings, transforms, normalisation, range checks at the value's place, shape errors at the
+// object's place, the image size limits, and warnings.
+#include "glint/io/scene_builder.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "glint/io/scene_limits.h"
+#include "glint/io/scene_loader.h"
+#include "glint/io/scene_parser.h"
+
+namespace glint {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr const char* kDesignExample = R"(name: basic render
+background: "#4b7f5a"
+ambient: { color: [1, 0.75, 0.75], intensity: 1 }
+camera:
+  position: [0, 0, 0]
+  direction: [0, 0, -1]
+  up: [0, 1, 0]
+  view_plane: { width: 500, height: 500, distance: 100 }
+  aperture: 0
+image:
+  width: 1000
+  height: 1000
+  samples: 1
+  encoding: srgb
+  grid: { interval: 100, color: "#ffff00" }
+render:
+  max_depth: 10
+  min_weight: 0.001
+  blur_samples: 16
+  seed: 0
+materials:
+  glass: { kd: 0.1, ks: 0.8, shininess: 200, kt: 0.9, ior: 1.5 }
+objects:
+  - { type: sphere, center: [0, 0, -100], radius: 50, material: glass }
+  - { type: triangle, vertices: [[-100, 0, -100], [0, 100, -100], [-100, 100, -100]],
+      emission: "#ff0000", material: { kd: 0.5, ks: 0.5, shininess: 60 } }
+lights:
+  - { type: spot, position: [-50, -50, 50], direction: [1, 1, -2], color: [1, 0.6, 0],
+      intensity: 1, attenuation: [1, 0.00001, 0.00000001], exponent: 1 }
+)";
+
+constexpr const char* kMinimal =
+    "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
+    "image: {width: 4, height: 3}\n";
+
+std::vector<Diagnostic> errorsOf(const std::string& text) {
+  try {
+    loadSceneFromString(text, "test.yaml");
+  } catch (const SceneError& e) {
+    return e.diagnostics();
+  }
+  return {};
+}
+
+void expectOneError(const std::string& text, int line, int column, const std::string& fragment) {
+  SCOPED_TRACE(text);
+  const std::vector<Diagnostic> errors = errorsOf(text);
+  ASSERT_EQ(errors.size(), 1u) << (errors.empty() ? "no error" : errors[0].format());
+  EXPECT_EQ(errors[0].where.line, line) << errors[0].format();
+  EXPECT_EQ(errors[0].where.column, column) << errors[0].format();
+  EXPECT_THAT(errors[0].message, HasSubstr(fragment));
+}
+
+// Loads a scene that must be valid.
+SceneParts partsOf(const std::string& text) {
+  try {
+    return loadSceneFromString(text, "test.yaml").parts;
+  } catch (const SceneError& e) {
+    ADD_FAILURE() << e.what();
+    return {};
+  }
+}
+
+void expectNear(const Point3& a, const Point3& b) {
+  EXPECT_NEAR(a.x, b.x, 1e-12);
+  EXPECT_NEAR(a.y, b.y, 1e-12);
+  EXPECT_NEAR(a.z, b.z, 1e-12);
+}
+
+void expectNear(const Vec3& a, const Vec3& b) { expectNear(toPoint(a), toPoint(b)); }
+
+void expectNear(const Color& a, const Color& b) {
+  EXPECT_NEAR(a.r, b.r, 1e-15);
+  EXPECT_NEAR(a.g, b.g, 1e-15);
+  EXPECT_NEAR(a.b, b.b, 1e-15);
+}
+
+TEST(SceneBuilder, DesignExampleBuildsTheExpectedParts) {
+  const LoadedScene loaded = loadSceneFromString(kDesignExample, "scene.yaml");
+  EXPECT_TRUE(loaded.warnings.empty());
+  const SceneParts& p = loaded.parts;
+  EXPECT_EQ(p.name, "basic render");
+  expectNear(p.background, Color(srgbToLinear(0x4b / 255.0), srgbToLinear(0x7f / 255.0),
+                                 srgbToLinear(0x5a / 255.0)));
+  EXPECT_EQ(p.ambient, Color(1, 0.75, 0.75));
+
+  EXPECT_EQ(p.camera.position, (Point3{0, 0, 0}));
+  EXPECT_EQ(p.camera.direction, (Vec3{0, 0, -1}));
+  EXPECT_EQ(p.camera.up, (Vec3{0, 1, 0}));
+  EXPECT_EQ(p.camera.viewPlaneWidth, 500);
+  EXPECT_EQ(p.camera.viewPlaneHeight, 500);
+  EXPECT_EQ(p.camera.viewPlaneDistance, 100);
+  EXPECT_EQ(p.camera.fovDegrees, 0);
+  EXPECT_EQ(p.camera.aperture, 0);
+  EXPECT_EQ(p.camera.imageWidth, 1000);
+  EXPECT_EQ(p.camera.imageHeight, 1000);
+
+  EXPECT_EQ(p.image.width, 1000);
+  EXPECT_EQ(p.image.height, 1000);
+  EXPECT_EQ(p.image.samples, 1);
+  EXPECT_EQ(p.image.encoding, Encoding::Srgb);
+  ASSERT_TRUE(p.image.grid);
+  EXPECT_EQ(p.image.grid->interval, 100);
+  expectNear(p.image.grid->color, Color(1, 1, 0));
+
+  EXPECT_EQ(p.render.maxDepth, 10);
+  EXPECT_EQ(p.render.minWeight, 0.001);
+  EXPECT_EQ(p.render.blurSamples, 16);
+  EXPECT_EQ(p.render.seed, 0u);
+
+  ASSERT_EQ(p.materials.size(), 3u);  // default, glass, the triangle's inline material
+  const Material& glass = p.materials[1];
+  EXPECT_EQ(glass.kd, Color(0.1));
+  EXPECT_EQ(glass.ks, Color(0.8));
+  EXPECT_EQ(glass.shininess, 200);
+  EXPECT_EQ(glass.kt, Color(0.9));
+  EXPECT_EQ(glass.kr, Color(0));
+  EXPECT_EQ(glass.ka, Color(1));
+  EXPECT_EQ(glass.ior, 1.5);
+  const Material& inlined = p.materials[2];
+  EXPECT_EQ(inlined.kd, Color(0.5));
+  EXPECT_EQ(inlined.ks, Color(0.5));
+  EXPECT_EQ(inlined.shininess, 60);
+  EXPECT_EQ(inlined.ior, 1);
+
+  ASSERT_EQ(p.primitives.size(), 2u);
+  const Sphere& sphere = std::get<Sphere>(p.primitives[0].shape());
+  EXPECT_EQ(sphere.center, (Point3{0, 0, -100}));
+  EXPECT_EQ(sphere.radius, 50);
+  EXPECT_EQ(p.primitives[0].materialIndex(), 1u);
+  EXPECT_EQ(p.primitives[0].emission(), Color());
+  const Triangle& triangle = std::get<Triangle>(p.primitives[1].shape());
+  EXPECT_EQ(triangle.v0, (Point3{-100, 0, -100}));
+  EXPECT_EQ(triangle.v1, (Point3{0, 100, -100}));
+  EXPECT_EQ(triangle.v2, (Point3{-100, 100, -100}));
+  EXPECT_EQ(p.primitives[1].materialIndex(), 2u);
+  EXPECT_EQ(p.primitives[1].emission(), Color(1, 0, 0));
+
+  ASSERT_EQ(p.lights.size(), 1u);
+  const SpotLight& spot = std::get<SpotLight>(p.lights[0]);
+  EXPECT_EQ(spot.position, (Point3{-50, -50, 50}));
+  expectNear(spot.direction, Vec3{1, 1, -2} / std::sqrt(6.0));
+  EXPECT_EQ(spot.intensity, Color(1, 0.6, 0));
+  EXPECT_EQ(spot.attenuation.kc, 1);
+  EXPECT_EQ(spot.attenuation.kl, 0.00001);
+  EXPECT_EQ(spot.attenuation.kq, 0.00000001);
+  EXPECT_EQ(spot.exponent, 1);
+
+  // The parts make a scene.
+  const Scene scene(p);
+  EXPECT_EQ(scene.primitives().size(), 2u);
+}
+
+TEST(SceneBuilder, HexColorsDecodeUnderTheImageEncoding) {
+  // The encoding is given after the colours: it must still decide how they decode.
+  const std::string scene =
+      "background: \"#4b7f5a\"\n"
+      "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1, emission: \"#FF8000\"}\n"
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n";
+  const SceneParts linear = partsOf(scene + "image: {width: 4, height: 3, encoding: linear}\n");
+  EXPECT_EQ(linear.background, Color(75 / 255.0, 127 / 255.0, 90 / 255.0));
+  EXPECT_EQ(linear.primitives.at(0).emission(), Color(1, 128 / 255.0, 0));
+
+  const SceneParts srgb = partsOf(scene + "image: {width: 4, height: 3}\n");
+  EXPECT_EQ(srgb.background,
+            Color(srgbToLinear(75 / 255.0), srgbToLinear(127 / 255.0), srgbToLinear(90 / 255.0)));
+  EXPECT_EQ(srgb.primitives.at(0).emission(), Color(1, srgbToLinear(128 / 255.0), 0));
+  // [r, g, b] is linear under either encoding, and may exceed 1.
+  EXPECT_EQ(partsOf(std::string(kMinimal) + "background: [0.25, 2, 0]\n").background,
+            Color(0.25, 2, 0));
+}
+
+TEST(SceneBuilder, DefaultsForOptionalKeys) {
+  const SceneParts p = partsOf(std::string(kMinimal) +
+                               "ambient: {intensity: 0.5}\n"
+                               "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1}\n"
+                               "lights:\n  - {type: point, position: [0, 5, 0]}\n");
+  EXPECT_EQ(p.name, "test.yaml");
+  EXPECT_EQ(p.background, Color());
+  EXPECT_EQ(p.ambient, Color(0.5));
+  EXPECT_EQ(p.image.samples, 1);
+  EXPECT_EQ(p.image.encoding, Encoding::Srgb);
+  EXPECT_FALSE(p.image.grid);
+  EXPECT_EQ(p.render.maxDepth, 10);
+  EXPECT_EQ(p.render.minWeight, 0.001);
+  EXPECT_EQ(p.render.blurSamples, 16);
+  EXPECT_EQ(p.camera.up, (Vec3{0, 1, 0}));
+  EXPECT_EQ(p.camera.fovDegrees, 40);
+  ASSERT_EQ(p.materials.size(), 1u);
+  EXPECT_EQ(p.primitives.at(0).materialIndex(), 0u);
+  const Material& m = p.materials[0];
+  EXPECT_EQ(m.kd, Color(0));
+  EXPECT_EQ(m.ka, Color(1));
+  EXPECT_EQ(m.ior, 1);
+  const PointLight& light = std::get<PointLight>(p.lights.at(0));
+  EXPECT_EQ(light.intensity, Color(1));
+  EXPECT_EQ(light.attenuation.kc, 1);
+  EXPECT_EQ(light.attenuation.kl, 0);
+  EXPECT_EQ(light.attenuation.kq, 0);
+}
+
+TEST(SceneBuilder, DirectionsAreNormalised) {
+  const SceneParts p = partsOf(
+      "camera: {position: [1, 2, 3], look_at: [1, 2, -7], up: [0, 3, 0], fov: 40}\n"
+      "image: {width: 4, height: 3}\n"
+      "objects:\n"
+      "  - {type: plane, point: [0, 0, 0], normal: [0, 0, 4]}\n"
+      "  - {type: disk, center: [0, 0, 0], normal: [3, 0, 4], radius: 1}\n"
+      "  - {type: cylinder, base: [0, 0, 0], axis: [0, 0.5, 0], radius: 1, height: 2}\n"
+      "  - {type: tube, origin: [0, 0, 0], axis: [-2, 0, 0], radius: 1}\n"
+      "lights:\n"
+      "  - {type: directional, direction: [0, -10, 0]}\n"
+      "  - {type: spot, position: [0, 0, 0], direction: [2, 2, 1]}\n");
+  EXPECT_EQ(p.camera.direction, (Vec3{0, 0, -1}));
+  EXPECT_EQ(p.camera.up, (Vec3{0, 1, 0}));
+  ASSERT_EQ(p.primitives.size(), 4u);
+  EXPECT_EQ(std::get<Plane>(p.primitives[0].shape()).normal, Normal3(0, 0, 1));
+  const Normal3 diskNormal = std::get<Disk>(p.primitives[1].shape()).normal;
+  expectNear(Vec3{diskNormal.x, diskNormal.y, diskNormal.z}, Vec3{0.6, 0, 0.8});
+  expectNear(std::get<Cylinder>(p.primitives[2].shape()).axis, Vec3{0, 1, 0});
+  EXPECT_EQ(std::get<Cylinder>(p.primitives[2].shape()).height, 2);
+  expectNear(std::get<Tube>(p.primitives[3].shape()).axis, Vec3{-1, 0, 0});
+  EXPECT_EQ(std::get<DirectionalLight>(p.lights.at(0)).direction, (Vec3{0, -1, 0}));
+  expectNear(std::get<SpotLight>(p.lights.at(1)).direction, Vec3{2, 2, 1} / 3.0);
+}
+
+TEST(SceneBuilder, TransformsApplyInFileOrder) {
+  // translate then scale: x ↦ 2(x + 1), so the unit sphere's box [-1, 1] becomes [0, 4].
+  const SceneParts p = partsOf(std::string(kMinimal) +
+                               "objects:\n"
+                               "  - type: sphere\n"
+                               "    center: [0, 0, 0]\n"
+                               "    radius: 1\n"
+                               "    transform: [{translate: [1, 0, 0]}, {scale: 2}]\n"
+                               "  - type: sphere\n"
+                               "    center: [2, 0, 0]\n"
+                               "    radius: 0.5\n"
+                               "    transform: [{rotate: {axis: [0, 0, 5], angle: 90}},\n"
+                               "                {scale: [1, 3, 1]}]\n"
+                               "  - {type: sphere, center: [0, 0, 0], radius: 1,\n"
+                               "     transform: [{translate: [0, 0, 0]}]}\n");
+  ASSERT_EQ(p.primitives.size(), 3u);
+  const Bounds3 a = p.primitives[0].bounds();
+  expectNear(a.lo, Point3{0, -2, -2});
+  expectNear(a.hi, Point3{4, 2, 2});
+  // Rotating (2, 0, 0) by 90° about +z gives (0, 2, 0); the scale then stretches y by 3.
+  const Bounds3 b = p.primitives[1].bounds();
+  expectNear(b.lo, Point3{-0.5, 4.5, -0.5});
+  expectNear(b.hi, Point3{0.5, 7.5, 0.5});
+  // An identity transform changes nothing.
+  expectNear(p.primitives[2].bounds().lo, Point3{-1, -1, -1});
+}
+
+TEST(SceneBuilder, PlaneFromThreePoints) {
+  const SceneParts p =
+      partsOf(std::string(kMinimal) +
+              "objects:\n  - {type: plane, points: [[0, 0, 1], [1, 0, 1], [0, 1, 1]]}\n");
+  const Plane& plane = std::get<Plane>(p.primitives.at(0).shape());
+  EXPECT_EQ(plane.normal, Normal3(0, 0, 1));
+}
+
+TEST(SceneBuilder, ValuesOutOfRangeAtTheValue) {
+  struct Case {
+    std::string text;  // appended to kMinimal
+    int line, column;
+    std::string fragment;
+  };
+  const std::vector<Case> cases = {
+      {"objects:\n  - {type: sphere, center: [0, 0, 0], radius: -2}\n", 4, 47,
+       "sphere.radius must be > 0, got -2"},
+      {"objects:\n  - {type: cylinder, base: [0, 0, 0], axis: [0, 1, 0], radius: 1, height: 0}\n",
+       4, 75, "cylinder.height must be > 0, got 0"},
+      {"materials: {m: {kd: -1}}\n", 3, 21, "materials.m.kd must be >= 0, got -1"},
+      {"materials: {m: {ks: [0.5, -1, 0]}}\n", 3, 21,
+       "materials.m.ks must be >= 0, got [0.5, -1, 0]"},
+      {"materials: {m: {kr: -0.1}}\n", 3, 21, "materials.m.kr must be >= 0"},
+      {"materials: {m: {kt: -0.1}}\n", 3, 21, "materials.m.kt must be >= 0"},
+      {"materials: {m: {ka: -0.1}}\n", 3, 21, "materials.m.ka must be >= 0"},
+      {"materials: {m: {shininess: -1}}\n", 3, 28, "materials.m.shininess must be >= 0"},
+      {"materials: {m: {ior: 0}}\n", 3, 22, "materials.m.ior must be > 0, got 0"},
+      {"materials: {m: {reflection_blur: -5}}\n", 3, 34, "reflection_blur must be >= 0"},
+      {"objects:\n  - {type: disk, center: [0, 0, 0], normal: [0, 0, 1], radius: 1,\n"
+       "     material: {kd: -2}}\n",
+       5, 21, "disk.material.kd must be >= 0, got -2"},
+      {"lights:\n  - {type: point, position: [0, 0, 0], intensity: -1}\n", 4, 51,
+       "point light.intensity must be >= 0, got -1"},
+      {"lights:\n  - {type: point, position: [0, 0, 0], attenuation: [1, -1, 0]}\n", 4, 53,
+       "point light.attenuation components must be >= 0"},
+      {"lights:\n  - {type: point, position: [0, 0, 0], attenuation: [0, 0, 0]}\n", 4, 53,
+       "point light.attenuation must not be all 0"},
+      {"lights:\n  - {type: spot, position: [0, 0, 0], direction: [0, 0, 1], exponent: -1}\n", 4,
+       71, "spot light.exponent must be >= 0"},
+      {"lights:\n  - {type: directional, direction: [0, 0, 1], color: [1, -1, 1]}\n", 4, 54,
+       "directional light.color components must be >= 0"},
+      {"render: {max_depth: 0}\n", 3, 21, "render.max_depth must be between 1 and 1000, got 0"},
+      {"render: {min_weight: -0.5}\n", 3, 22, "render.min_weight must be >= 0, got -0.5"},
+      {"render: {blur_samples: 0}\n", 3, 24, "render.blur_samples must be between 1 and 65536"},
+      {"render: {blur_samples: 65537}\n", 3, 24, "render.blur_samples must be between 1 and 65536"},
+      {"background: [-1, 0, 0]\n", 3, 13, "background components must be >= 0, got [-1, 0, 0]"},
+      {"ambient: {color: [1, 1, 1], intensity: -1}\n", 3, 40, "ambient.intensity must be >= 0"},
+      {"objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, emission: [0, -1, 0]}\n", 4, 60,
+       "sphere.emission components must be >= 0"},
+  };
+  for (const Case& c : cases)
+    expectOneError(std::string(kMinimal) + c.text, c.line, c.column, c.fragment);
+}
+
+TEST(SceneBuilder, ImageAndCameraRanges) {
+  const std::string camera = "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n";
+  expectOneError(camera + "image: {width: 0, height: 3}\n", 2, 16,
+                 "image.width must be between 1 and 65535, got 0");
+  expectOneError(camera + "image: {width: 4, height: 65536}\n", 2, 27,
+                 "image.height must be between 1 and 65535, got 65536");
+  expectOneError(camera + "image: {width: 4, height: 3, samples: 0}\n", 2, 39,
+                 "image.samples must be between 1 and 65536, got 0");
+  expectOneError(camera + "image: {width: 4, height: 3, samples: 65537}\n", 2, 39,
+                 "image.samples must be between 1 and 65536");
+  expectOneError(camera + "image: {width: 4, height: 3, grid: {interval: 0}}\n", 2, 47,
+                 "image.grid.interval must be >= 1, got 0");
+  const std::string image = "image: {width: 4, height: 3}\n";
+  expectOneError("camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 180}\n" + image, 1, 59,
+                 "camera.fov must be in (0, 180) degrees, got 180");
+  expectOneError("camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 0}\n" + image, 1, 59,
+                 "camera.fov must be in (0, 180)");
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1],\n"
+      "         view_plane: {width: 0, height: 1, distance: 1}}\n" +
+          image,
+      2, 30, "camera.view_plane.width must be > 0, got 0");
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40, aperture: -1}\n" + image, 1,
+      73, "camera.aperture must be >= 0");
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40, aperture: 0.5}\n" + image, 1,
+      73, "camera.focus_distance is required when camera.aperture > 0");
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40, aperture: 0.5,\n"
+      "         focus_distance: 0}\n" +
+          image,
+      2, 26, "camera.focus_distance must be > 0");
+  const SceneParts lens = partsOf(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40, aperture: 0.5,\n"
+      "         focus_distance: 7}\n" +
+      image);
+  EXPECT_EQ(lens.camera.aperture, 0.5);
+  EXPECT_EQ(lens.camera.focusDistance, 7);
+}
+
+TEST(SceneBuilder, ZeroLengthDirectionsAreErrors) {
+  const std::string image = "image: {width: 4, height: 3}\n";
+  expectOneError("camera: {position: [0, 0, 0], direction: [0, 0, 0], fov: 40}\n" + image, 1, 42,
+                 "camera.direction must be non-zero, got [0, 0, 0]");
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, 1], up: [0, 0, 0], fov: 40}\n" + image, 1,
+      57, "camera.up must be non-zero");
+  expectOneError("camera: {position: [1, 2, 3], look_at: [1, 2, 3], fov: 40}\n" + image, 1, 40,
+                 "camera.look_at must differ from camera.position");
+  expectOneError(
+      std::string(kMinimal) +
+          "objects:\n  - {type: disk, center: [0, 0, 0], normal: [0, 0, 0], radius: 1}\n",
+      4, 45, "disk.normal must be non-zero, got [0, 0, 0]");
+  expectOneError(std::string(kMinimal) +
+                     "objects:\n  - {type: tube, origin: [0, 0, 0], axis: [0, 0, 0], radius: 1}\n",
+                 4, 43, "tube.axis must be non-zero");
+  expectOneError(std::string(kMinimal) + "lights:\n  - {type: directional, direction: [0, 0, 0]}\n",
+                 4, 36, "directional light.direction must be non-zero");
+  expectOneError(std::string(kMinimal) +
+                     "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1,\n"
+                     "     transform: [{rotate: {axis: [0, 0, 0], angle: 30}}]}\n",
+                 5, 34, "sphere.transform[0].rotate.axis must be non-zero");
+  expectOneError(std::string(kMinimal) +
+                     "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1,\n"
+                     "     transform: [{scale: [1, 0, 1]}]}\n",
+                 5, 26, "sphere.transform[0].scale factors must be non-zero, got [1, 0, 1]");
+}
+
+TEST(SceneBuilder, UpParallelToTheViewDirection) {
+  const std::string image = "image: {width: 4, height: 3}\n";
+  // Reported at `up` when given, else at the direction that meets the default up.
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, 1], up: [0, 0, -3], fov: 40}\n" + image, 1,
+      57, "camera.up [0, 0, -3] is parallel to the view direction");
+  expectOneError("camera: {position: [0, 0, 0], direction: [0, 2, 0], fov: 40}\n" + image, 1, 42,
+                 "is parallel to the view direction");
+}
+
+TEST(SceneBuilder, UndefinedMaterialIsNamed) {
+  expectOneError(std::string(kMinimal) +
+                     "materials: {glass: {kt: 1}}\n"
+                     "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: glas}\n",
+                 5, 60, "undefined material 'glas' (did you mean 'glass'?)");
+  expectOneError(
+      std::string(kMinimal) +
+          "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: steel}\n",
+      4, 60, "undefined material 'steel'; no materials are defined");
+}
+
+TEST(SceneBuilder, DegenerateShapesAtTheKeyTheyName) {
+  // The factory's refusal is reported at the value of the key it names, else at the object.
+  const auto expectShapeError = [](const std::string& object, const std::string& key,
+                                   const std::string& fragment) {
+    const std::string line = "  - " + object;
+    const int column = static_cast<int>(key.empty() ? 5 : line.find(key + ": ") + key.size() + 3);
+    expectOneError(std::string(kMinimal) +
+                       "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1}\n" + line + "\n",
+                   5, column, fragment);
+  };
+  expectShapeError("{type: triangle, vertices: [[0, 0, 0], [1, 1, 1], [2, 2, 2]]}", "vertices",
+                   "objects[1] (triangle).vertices");
+  expectShapeError("{type: polygon, vertices: [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 1]]}",
+                   "vertices", "objects[1] (polygon)");
+  expectShapeError("{type: polygon, vertices: [[0, 0, 0], [2, 0, 0], [1, 0.2, 0], [1, 2, 0]]}",
+                   "vertices", "objects[1] (polygon)");
+  expectShapeError("{type: rectangle, corner: [0, 0, 0], edges: [[1, 0, 0], [1, 1, 0]]}", "edges",
+                   "objects[1] (rectangle).edges");
+  expectShapeError("{type: quadrangle, vertices: [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 1]]}",
+                   "vertices", "objects[1] (quadrangle)");
+  expectShapeError("{type: plane, points: [[0, 0, 0], [1, 1, 1], [2, 2, 2]]}", "points",
+                   "objects[1] (plane)");
+  expectShapeError("{type: box, min: [0, 0, 0], max: [1, 0, 1]}", "min", "objects[1] (box)");
+}
+
+TEST(SceneBuilder, BuildsHandMadeDescriptions) {
+  SceneDescription d;
+  d.file = "made.yaml";
+  // Complete entities missing required parts are reported by the builder itself.
+  BuildResult r = buildScene(d);
+  ASSERT_EQ(r.diagnostics.size(), 2u);
+  EXPECT_THAT(r.diagnostics[0].message, HasSubstr("missing required key 'image'"));
+  EXPECT_THAT(r.diagnostics[1].message, HasSubstr("missing required key 'camera'"));
+
+  d.image = ImageDescription{};
+  d.image->width = Located<std::int64_t>{640, {"made.yaml", 2, 3}};
+  d.image->height = Located<std::int64_t>{480, {"made.yaml", 3, 3}};
+  d.camera = CameraDescription{};
+  d.camera->position = Located<Point3>{{0, 0, 0}, {}};
+  d.camera->direction = Located<Vec3>{{0, 0, -2}, {}};
+  d.camera->fov = Located<double>{60, {}};
+  ObjectDescription sphere;
+  sphere.type = ShapeType::Sphere;
+  sphere.typeName = "sphere";
+  sphere.center = Located<Point3>{{0, 0, -5}, {}};
+  sphere.radius = Located<double>{-1, {"made.yaml", 9, 13}};
+  d.objects.push_back(sphere);
+  r = buildScene(d);
+  ASSERT_EQ(r.diagnostics.size(), 1u);
+  EXPECT_EQ(r.diagnostics[0].format(), "made.yaml:9:13: sphere.radius must be > 0, got -1");
+
+  d.objects[0].radius->value = 2;
+  r = buildScene(d);
+  EXPECT_FALSE(r.hasErrors());
+  EXPECT_EQ(r.parts.camera.direction, (Vec3{0, 0, -1}));
+  EXPECT_EQ(r.parts.camera.imageWidth, 640);
+  ASSERT_EQ(r.parts.primitives.size(), 1u);
+}
+
+TEST(SceneBuilder, ImageSizeLimits) {
+  // Ranges, then the film against the memory budget, then the camera-ray cap.
+  EXPECT_EQ(checkRenderSize(1000, 1000, 16, std::uint64_t{1} << 30), std::nullopt);
+  EXPECT_THAT(checkRenderSize(0, 10, 1).value_or(""), HasSubstr("between 1 and 65535"));
+  EXPECT_THAT(checkRenderSize(10, 10, 65537).value_or(""), HasSubstr("between 1 and 65536"));
+  const std::optional<std::string> film = checkRenderSize(1000, 1000, 1, std::uint64_t{1} << 20);
+  ASSERT_TRUE(film);
+  EXPECT_THAT(*film, HasSubstr("needs 22.9 MiB for its film"));
+  EXPECT_THAT(*film, HasSubstr("budget of 1.0 MiB"));
+  const std::optional<std::string> rays =
+      checkRenderSize(65535, 65535, 65536, std::numeric_limits<std::uint64_t>::max());
+  ASSERT_TRUE(rays);
+  EXPECT_THAT(*rays, HasSubstr("camera rays"));
+  EXPECT_EQ(filmBytes(65535, 65535), std::uint64_t{65535} * 65535 * sizeof(Color));
+  EXPECT_EQ(formatBytes(512), "512 B");
+  EXPECT_EQ(formatBytes(1536), "1.5 KiB");
+  EXPECT_EQ(formatCount(1.1e12), "1.1 trillion");
+  EXPECT_GT(physicalMemoryBytes(), 0u);
+  EXPECT_EQ(defaultImageMemoryBudget(), physicalMemoryBytes() / 2);
+
+  ImageSettings image;
+  image.width = 2000;
+  image.height = 1000;
+  image.samples = 4;
+  EXPECT_EQ(checkImageSettings(image, std::uint64_t{1} << 30), std::nullopt);
+  image.samples = 0;
+  EXPECT_TRUE(checkImageSettings(image, std::uint64_t{1} << 30));
+}
+
+TEST(SceneBuilder, HugeImageRefusedBeforeAllocation) {
+  // Through the builder with a small budget: the error points at the image mapping.
+  const ParseResult parsed = parseScene(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
+      "image:\n  width: 2000\n  height: 1000\n",
+      "big.yaml");
+  ASSERT_FALSE(parsed.hasErrors());
+  const BuildResult built = buildScene(parsed.description, BuildOptions{std::uint64_t{16} << 20});
+  ASSERT_EQ(built.diagnostics.size(), 1u);
+  EXPECT_EQ(built.diagnostics[0].format(),
+            "big.yaml:3:3: image: an image of 2000 × 1000 pixels needs 45.8 MiB for its film, more "
+            "than the memory budget of 16.0 MiB");
+
+  // Through the loader with the default budget (half the physical memory). 65535² pixels need
+  // 96 GiB of film; only a machine with more than 192 GiB would accept it.
+  if (filmBytes(65535, 65535) <= defaultImageMemoryBudget()) {
+    GTEST_SKIP() << "this machine has enough memory for a 65535 × 65535 film";
+  }
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
+      "image: {width: 65535, height: 65535}\n",
+      2, 8, "needs 96.0 GiB for its film");
+  // The ray cap applies whatever the memory.
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
+      "image: {width: 20000, height: 20000, samples: 4096}\n",
+      2, 8, "camera rays");
+}
+
+TEST(SceneBuilder, Warnings) {
+  const LoadedScene dark = loadSceneFromString(
+      std::string(kMinimal) + "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1}\n",
+      "dark.yaml");
+  ASSERT_EQ(dark.warnings.size(), 1u);
+  EXPECT_EQ(dark.warnings[0].severity, Diagnostic::Severity::Warning);
+  EXPECT_THAT(dark.warnings[0].format(), HasSubstr("dark.yaml: warning: the scene has no lights"));
+
+  const LoadedScene off =
+      loadSceneFromString(std::string(kMinimal) +
+                              "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1}\n"
+                              "lights:\n"
+                              "  - {type: point, position: [0, 0, 0]}\n"
+                              "  - {type: point, position: [0, 0, 0], intensity: 0}\n"
+                              "  - {type: directional, direction: [0, 0, 1], color: [0, 0, 0]}\n",
+                          "off.yaml");
+  ASSERT_EQ(off.warnings.size(), 2u);
+  EXPECT_EQ(off.warnings[0].format(),
+            "off.yaml:7:5: warning: point light has zero intensity; it lights nothing");
+  EXPECT_EQ(off.warnings[1].where.line, 8);
+  EXPECT_EQ(off.parts.lights.size(), 3u);
+
+  // Lit scenes have none.
+  EXPECT_TRUE(
+      loadSceneFromString(std::string(kMinimal) +
+                              "ambient: {color: [1, 1, 1]}\n"
+                              "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1}\n",
+                          "lit.yaml")
+          .warnings.empty());
+}
+
+}  // namespace
+}  // namespace glint

@@ -1,0 +1,472 @@
+// Scene-file parsing (DESIGN.md §5, §7): the text → SceneDescription half, and the error reporting
+// of loadSceneFromString for problems of structure, type and syntax, each at its line and column.
+#include "glint/io/scene_parser.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "glint/io/scene_loader.h"
+
+namespace glint {
+namespace {
+
+using ::testing::HasSubstr;
+
+// The scene of DESIGN.md §5, verbatim.
+constexpr const char* kDesignExample = R"(name: basic render                 # optional
+background: "#4b7f5a"              # default black
+ambient: { color: [1, 0.75, 0.75], intensity: 1 }     # default none
+camera:
+  position: [0, 0, 0]
+  direction: [0, 0, -1]            # or look_at: [x, y, z]
+  up: [0, 1, 0]                    # default [0, 1, 0]
+  view_plane: { width: 500, height: 500, distance: 100 }   # or fov: 40
+  aperture: 0                      # optional, with focus_distance
+image:
+  width: 1000                      # pixels
+  height: 1000
+  samples: 1                       # per pixel
+  encoding: srgb                   # srgb (default) | linear (value × 255, rounded to nearest)
+  grid: { interval: 100, color: "#ffff00" }   # optional: after rendering, paints every pixel
+                                              # whose column or row is a multiple of interval (0 too)
+render:
+  max_depth: 10
+  min_weight: 0.001
+  blur_samples: 16
+  seed: 0
+materials:
+  glass: { kd: 0.1, ks: 0.8, shininess: 200, kt: 0.9, ior: 1.5 }
+objects:
+  - { type: sphere, center: [0, 0, -100], radius: 50, material: glass }
+  - { type: triangle, vertices: [[-100, 0, -100], [0, 100, -100], [-100, 100, -100]],
+      emission: "#ff0000", material: { kd: 0.5, ks: 0.5, shininess: 60 } }
+lights:
+  - { type: spot, position: [-50, -50, 50], direction: [1, 1, -2], color: [1, 0.6, 0],
+      intensity: 1, attenuation: [1, 0.00001, 0.00000001], exponent: 1 }
+)";
+
+// The smallest valid scene; tests append the keys they exercise.
+constexpr const char* kMinimal =
+    "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
+    "image: {width: 4, height: 3}\n";
+
+std::vector<Diagnostic> errorsOf(const std::string& text) {
+  try {
+    loadSceneFromString(text, "test.yaml");
+  } catch (const SceneError& e) {
+    return e.diagnostics();
+  }
+  return {};
+}
+
+// Expects exactly one error, at line:column, whose message contains `fragment`.
+void expectOneError(const std::string& text, int line, int column, const std::string& fragment) {
+  const std::vector<Diagnostic> errors = errorsOf(text);
+  ASSERT_EQ(errors.size(), 1u) << text << "\nfirst: " << (errors.empty() ? "" : errors[0].format());
+  EXPECT_EQ(errors[0].where.file, "test.yaml");
+  EXPECT_EQ(errors[0].where.line, line) << errors[0].format();
+  EXPECT_EQ(errors[0].where.column, column) << errors[0].format();
+  EXPECT_THAT(errors[0].message, HasSubstr(fragment));
+  EXPECT_EQ(errors[0].severity, Diagnostic::Severity::Error);
+}
+
+TEST(SceneParser, DesignExampleParsesWithLocations) {
+  const ParseResult r = parseScene(kDesignExample, "scene.yaml", "/scenes");
+  ASSERT_FALSE(r.hasErrors()) << r.diagnostics[0].format();
+  const SceneDescription& d = r.description;
+  EXPECT_TRUE(d.complete);
+  EXPECT_EQ(d.file, "scene.yaml");
+  EXPECT_EQ(d.baseDirectory, std::filesystem::path("/scenes"));
+  ASSERT_TRUE(d.name);
+  EXPECT_EQ(d.name->value, "basic render");
+  ASSERT_TRUE(d.background);
+  EXPECT_TRUE(d.background->isHex);
+  EXPECT_EQ(d.background->code, (std::array<std::uint8_t, 3>{0x4b, 0x7f, 0x5a}));
+  EXPECT_EQ(d.background->where.line, 2);
+  EXPECT_EQ(d.background->where.column, 13);
+
+  ASSERT_TRUE(d.camera && d.camera->viewPlane && d.camera->direction && d.camera->up);
+  EXPECT_EQ(d.camera->direction->value, (Vec3{0, 0, -1}));
+  EXPECT_EQ(d.camera->direction->where.line, 6);
+  EXPECT_EQ(d.camera->direction->where.column, 14);
+  EXPECT_EQ(d.camera->viewPlane->distance->value, 100);
+  EXPECT_FALSE(d.camera->fov);
+
+  ASSERT_TRUE(d.image && d.image->grid && d.image->encoding);
+  EXPECT_EQ(d.image->width->value, 1000);
+  EXPECT_EQ(d.image->encoding->value, Encoding::Srgb);
+  EXPECT_EQ(d.image->grid->interval->value, 100);
+  ASSERT_TRUE(d.render);
+  EXPECT_EQ(d.render->maxDepth->value, 10);
+  EXPECT_EQ(d.render->minWeight->value, 0.001);
+  EXPECT_EQ(d.render->seed->value, 0u);
+
+  ASSERT_EQ(d.materials.size(), 1u);
+  EXPECT_EQ(d.materials[0].name, "glass");
+  EXPECT_EQ(d.materials[0].ior->value, 1.5);
+  EXPECT_EQ(d.materials[0].kt->value, Color(0.9));
+  EXPECT_FALSE(d.materials[0].kr);
+
+  ASSERT_EQ(d.objects.size(), 2u);
+  EXPECT_EQ(d.objects[0].type, ShapeType::Sphere);
+  EXPECT_EQ(d.objects[0].where.line, 25);
+  EXPECT_EQ(d.objects[0].where.column, 5);
+  EXPECT_EQ(d.objects[0].materialName->value, "glass");
+  EXPECT_EQ(d.objects[1].type, ShapeType::Triangle);
+  EXPECT_EQ(d.objects[1].vertices->value.size(), 3u);
+  ASSERT_TRUE(d.objects[1].inlineMaterial);
+  EXPECT_EQ(d.objects[1].inlineMaterial->shininess->value, 60);
+  EXPECT_EQ(d.objects[1].emission->code, (std::array<std::uint8_t, 3>{0xff, 0, 0}));
+
+  ASSERT_EQ(d.lights.size(), 1u);
+  EXPECT_EQ(d.lights[0].type, LightType::Spot);
+  EXPECT_EQ(d.lights[0].attenuation->value, (std::array<double, 3>{1, 0.00001, 0.00000001}));
+  EXPECT_EQ(d.lights[0].where.line, 29);
+}
+
+TEST(SceneParser, JsonInputWorks) {
+  const std::string json = R"({
+  "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 45},
+  "image": {"width": 64, "height": 48, "encoding": "linear"},
+  "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1.5E+0,
+               "material": {"kd": [0.5, 0.25, 1]}}],
+  "lights": [{"type": "point", "position": [1, 2, 3], "intensity": 2}]
+})";
+  const LoadedScene s = loadSceneFromString(json, "scene.json");
+  EXPECT_EQ(s.parts.image.width, 64);
+  EXPECT_EQ(s.parts.image.encoding, Encoding::Linear);
+  ASSERT_EQ(s.parts.primitives.size(), 1u);
+  EXPECT_EQ(std::get<Sphere>(s.parts.primitives[0].shape()).radius, 1.5);
+  EXPECT_EQ(s.parts.materials.at(1).kd, Color(0.5, 0.25, 1));
+  ASSERT_EQ(s.parts.lights.size(), 1u);
+  EXPECT_EQ(std::get<PointLight>(s.parts.lights[0]).intensity, Color(2));
+}
+
+TEST(SceneParser, NumbersInAnyUsualNotation) {
+  const ParseResult r = parseScene(std::string(kMinimal) +
+                                       "lights:\n"
+                                       "  - {type: point, position: [1e-5, 1.5E+3, 0.00001],\n"
+                                       "     attenuation: [+2, .5, -3.25e2], intensity: 7.}\n",
+                                   "t.yaml");
+  ASSERT_FALSE(r.hasErrors()) << r.diagnostics[0].format();
+  const LightDescription& light = r.description.lights.at(0);
+  EXPECT_EQ(light.position->value, (Point3{1e-5, 1500, 0.00001}));
+  EXPECT_EQ(light.attenuation->value, (std::array<double, 3>{2, 0.5, -325}));
+  EXPECT_EQ(light.intensity->value, 7);
+}
+
+TEST(SceneParser, UnknownKeyAtTheKeyWithSuggestion) {
+  expectOneError(
+      std::string(kMinimal) + "objects:\n  - {type: sphere, center: [0, 0, 0], radus: 2}\n", 4, 39,
+      "unknown key 'radus' in sphere; expected one of: center, radius, material, "
+      "emission, transform");
+  const std::vector<Diagnostic> errors = errorsOf(
+      std::string(kMinimal) + "objects:\n  - {type: sphere, center: [0, 0, 0], radus: 2}\n");
+  ASSERT_FALSE(errors.empty());
+  EXPECT_THAT(errors[0].message, HasSubstr("did you mean 'radius'?"));
+  expectOneError(std::string(kMinimal) + "camra: {}\n", 3, 1,
+                 "unknown key 'camra' at the top level");
+  expectOneError(std::string(kMinimal) + "render: {max_dept: 3}\n", 3, 10,
+                 "did you mean 'max_depth'?");
+}
+
+TEST(SceneParser, DuplicateKeyAtTheSecondOccurrence) {
+  expectOneError(std::string(kMinimal) +
+                     "objects:\n"
+                     "  - type: sphere\n"
+                     "    center: [0, 0, 0]\n"
+                     "    radius: 1\n"
+                     "    radius: 2\n",
+                 7, 5, "duplicate key 'radius' in sphere (first at line 6, column 5)");
+  expectOneError(
+      "image: {width: 4, height: 3}\n"
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40, fov: 50}\n",
+      2, 63, "duplicate key 'fov'");
+}
+
+TEST(SceneParser, MaterialDefinedTwice) {
+  expectOneError(std::string(kMinimal) +
+                     "materials:\n"
+                     "  red: {kd: [1, 0, 0]}\n"
+                     "  red: {kd: 1}\n",
+                 5, 3, "duplicate material 'red': defined twice (first at line 4, column 3)");
+}
+
+TEST(SceneParser, SeveralDocumentsRejected) {
+  expectOneError(std::string(kMinimal) + "---\n" + kMinimal, 3, 1, "more than one YAML document");
+  expectOneError(std::string(kMinimal) + "---\n", 3, 1, "more than one YAML document");
+  // yaml-cpp 0.7's LoadAll never returns on a stray ',' outside brackets; the loader must.
+  expectOneError(",", 1, 1, "unexpected ',' here");
+  const std::vector<Diagnostic> errors = errorsOf(
+      "{camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}, image: {width: 4, "
+      "height: 3}},\n");
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].format(), "test.yaml:1:94: syntax error: unexpected ',' here");
+}
+
+TEST(SceneParser, SyntaxErrorAtItsMark) {
+  const std::vector<Diagnostic> errors = errorsOf("camera: {position: [0, 0, 0]\nimage: 3\n");
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].where.line, 2);
+  EXPECT_THAT(errors[0].message, HasSubstr("'{' is not closed"));
+  EXPECT_THAT(errors[0].message, ::testing::Not(HasSubstr("yaml-cpp")));
+  expectOneError("camera:\n\tposition: [0, 0, 0]\n", 2, 1, "tabs are not allowed");
+  expectOneError("name: \"a\\qb\"\n", 1, 11, "unknown escape sequence");
+}
+
+TEST(SceneParser, EmptyOrNonMappingFileAtLineOne) {
+  expectOneError("", 1, 1, "the file is empty");
+  expectOneError("# only a comment\n\n", 1, 1, "the file is empty");
+  expectOneError("- camera\n- image\n", 1, 1, "must be a mapping");
+  expectOneError("42\n", 1, 1, "must be a mapping");
+}
+
+TEST(SceneParser, MissingRequiredKeys) {
+  // A missing top-level section has no place of its own: line 1, column 1.
+  expectOneError("image: {width: 4, height: 3}\n", 1, 1, "missing required key 'camera'");
+  expectOneError("camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n", 1, 1,
+                 "missing required key 'image'");
+  // Otherwise the mapping that lacks the key.
+  expectOneError(std::string(kMinimal) + "objects:\n  - {type: sphere, center: [0, 0, 0]}\n", 4, 5,
+                 "sphere is missing required key 'radius'");
+  expectOneError("camera:\n  direction: [0, 0, -1]\n  fov: 40\nimage: {width: 4, height: 3}\n", 2,
+                 3, "camera is missing required key 'position'");
+  expectOneError("camera: {position: [0, 0, 0], fov: 40}\nimage: {width: 4, height: 3}\n", 1, 9,
+                 "camera needs 'direction' or 'look_at'");
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, 1]}\nimage: {width: 4, height: 3}\n", 1, 9,
+      "camera needs 'view_plane' or 'fov'");
+  expectOneError(std::string(kMinimal) + "objects:\n  - {center: [0, 0, 0], radius: 1}\n", 4, 5,
+                 "missing required key 'type'");
+  expectOneError(std::string(kMinimal) + "lights:\n  - {type: spot, position: [0, 0, 0]}\n", 4, 5,
+                 "spot light is missing required key 'direction'");
+  expectOneError(std::string(kMinimal) + "objects:\n  - {type: plane, point: [0, 0, 0]}\n", 4, 5,
+                 "plane is missing required key 'normal'");
+}
+
+TEST(SceneParser, WrongTypesAtTheValue) {
+  expectOneError(
+      std::string(kMinimal) + "objects:\n  - {type: sphere, center: [0, 0, 0], radius: abc}\n", 4,
+      47, "sphere.radius: expected a number, got 'abc'");
+  expectOneError(std::string(kMinimal) + "objects:\n  - {type: sphere, center: 5, radius: 1}\n", 4,
+                 28, "sphere.center: expected a list of 3 numbers [x, y, z], got '5'");
+  expectOneError(
+      std::string(kMinimal) + "objects:\n  - {type: sphere, center: [1, 2], radius: 1}\n", 4, 28,
+      "expected a list of 3 numbers [x, y, z], got a list of 2 items");
+  expectOneError(
+      std::string(kMinimal) + "objects:\n  - {type: sphere, center: [1, x, 3], radius: 1}\n", 4, 32,
+      "sphere.center[1]: expected a number, got 'x'");
+  expectOneError(std::string(kMinimal) + "background: red\n", 3, 13,
+                 "expected a color [r, g, b] or \"#rrggbb\", got 'red'");
+  expectOneError(std::string(kMinimal) + "background: \"#12345g\"\n", 3, 13,
+                 "6 hexadecimal digits");
+  expectOneError(
+      std::string(kMinimal) + "materials: {m: {kd: {r: 1}}}\n", 3, 21,
+      "materials.m.kd: expected a number or a list of 3 numbers [r, g, b], got a mapping");
+  expectOneError(std::string(kMinimal) + "objects: {type: sphere}\n", 3, 10,
+                 "objects: expected a list of objects, got a mapping");
+  expectOneError(
+      std::string(kMinimal) + "objects:\n  - {type: triangle, vertices: [[0, 0, 0], [1, 0, 0]]}\n",
+      4, 32, "expected a list of 3 points");
+  expectOneError(std::string(kMinimal) + "image2: 1\n", 3, 1, "unknown key 'image2'");
+}
+
+TEST(SceneParser, EmptyValueReportedAtItsKey) {
+  expectOneError(std::string(kMinimal) + "objects:\n  - type: sphere\n    center:\n    radius: 1\n",
+                 5, 5, "sphere.center: expected a list of 3 numbers [x, y, z], got nothing");
+}
+
+TEST(SceneParser, WholeNumbersWhereIntegersAreNeeded) {
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
+      "image: {width: 1.5, height: 3}\n",
+      2, 16, "image.width: expected a whole number, got 1.5");
+  const LoadedScene s = loadSceneFromString(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
+      "image: {width: 1e3, height: 2.0E2}\n"
+      "render: {seed: 18446744073709551615}\n",
+      "t.yaml");
+  EXPECT_EQ(s.parts.image.width, 1000);
+  EXPECT_EQ(s.parts.image.height, 200);
+  EXPECT_EQ(s.parts.render.seed, 18446744073709551615u);
+  expectOneError(std::string(kMinimal) + "render: {seed: -1}\n", 3, 16,
+                 "render.seed must be between 0");
+}
+
+TEST(SceneParser, NanAndInfinityRejectedEverywhere) {
+  expectOneError(std::string(kMinimal) + "render: {min_weight: .nan}\n", 3, 22,
+                 "render.min_weight must be a finite number, got .nan");
+  expectOneError(std::string(kMinimal) + "ambient: {intensity: .inf}\n", 3, 22, "finite");
+  expectOneError(std::string(kMinimal) + "background: [0, -.inf, 0]\n", 3, 17,
+                 "background[1] must be a finite");
+  expectOneError(
+      std::string(kMinimal) + "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1e999}\n", 4,
+      47, "finite");
+  expectOneError(std::string(kMinimal) + "lights:\n  - {type: point, position: [nan, 0, 0]}\n", 4,
+                 30, "finite");
+}
+
+TEST(SceneParser, ConflictingChoicesAtTheLaterKey) {
+  expectOneError(
+      "camera:\n  position: [0, 0, 0]\n  direction: [0, 0, -1]\n  look_at: [0, 0, -5]\n"
+      "  fov: 40\nimage: {width: 4, height: 3}\n",
+      4, 3, "camera has both 'direction' and 'look_at'");
+  expectOneError(
+      "camera:\n  position: [0, 0, 0]\n  fov: 40\n  direction: [0, 0, -1]\n"
+      "  view_plane: {width: 1, height: 1, distance: 1}\nimage: {width: 4, height: 3}\n",
+      5, 3, "camera has both 'view_plane' and 'fov'");
+  expectOneError(std::string(kMinimal) +
+                     "objects:\n  - {type: plane, points: [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "
+                     "normal: [0, 0, 1]}\n",
+                 4, 62, "plane has both 'points' and 'point'/'normal'");
+}
+
+TEST(SceneParser, MeshObjectsAreNotSupportedYet) {
+  expectOneError(std::string(kMinimal) + "objects:\n  - type: mesh\n    file: bunny.obj\n", 4, 5,
+                 "mesh objects are not supported yet");
+}
+
+TEST(SceneParser, UnknownTypesListTheKnownOnes) {
+  expectOneError(std::string(kMinimal) + "lights:\n  - {type: area, position: [0, 0, 0]}\n", 4, 12,
+                 "unknown light type 'area'; expected one of: directional, point, spot");
+  expectOneError(std::string(kMinimal) + "objects:\n  - {type: sphre}\n", 4, 12,
+                 "unknown object type 'sphre'; expected one of: sphere, plane, triangle, polygon, "
+                 "rectangle, quadrangle, tube, cylinder, box, disk (did you mean 'sphere'?)");
+  expectOneError(std::string(kMinimal) + "lights:\n  - {type: ambient}\n", 4, 12,
+                 "top-level key 'ambient'");
+  expectOneError(std::string(kMinimal) + "image2: {}\n", 3, 1, "did you mean 'image'?");
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
+      "image: {width: 4, height: 3, encoding: srbg}\n",
+      2, 40, "image.encoding must be srgb or linear, got 'srbg' (did you mean 'srgb'?)");
+}
+
+TEST(SceneParser, TransformSteps) {
+  const ParseResult r = parseScene(std::string(kMinimal) +
+                                       "objects:\n"
+                                       "  - type: box\n"
+                                       "    min: [0, 0, 0]\n"
+                                       "    max: [1, 1, 1]\n"
+                                       "    transform:\n"
+                                       "      - {translate: [1, 2, 3]}\n"
+                                       "      - {scale: 2}\n"
+                                       "      - {scale: [1, 2, 3]}\n"
+                                       "      - {rotate: {axis: [0, 0, 2], angle: 90}}\n",
+                                   "t.yaml");
+  ASSERT_FALSE(r.hasErrors()) << r.diagnostics[0].format();
+  const std::vector<TransformStep>& steps = r.description.objects.at(0).transform;
+  ASSERT_EQ(steps.size(), 4u);
+  EXPECT_EQ(steps[0].kind, TransformStep::Kind::Translate);
+  EXPECT_EQ(steps[0].vector.value, (Vec3{1, 2, 3}));
+  EXPECT_EQ(steps[1].vector.value, (Vec3{2, 2, 2}));
+  EXPECT_EQ(steps[2].vector.value, (Vec3{1, 2, 3}));
+  EXPECT_EQ(steps[3].kind, TransformStep::Kind::Rotate);
+  EXPECT_EQ(steps[3].angle.value, 90);
+  EXPECT_EQ(steps[3].where.line, 11);
+
+  expectOneError(std::string(kMinimal) +
+                     "objects:\n  - {type: box, min: [0, 0, 0], max: [1, 1, 1],\n"
+                     "     transform: [{translate: [1, 2, 3], scale: 2}]}\n",
+                 5, 41, "put 'scale' in a step of its own");
+  expectOneError(std::string(kMinimal) +
+                     "objects:\n  - {type: box, min: [0, 0, 0], max: [1, 1, 1],\n"
+                     "     transform: [{rotate: {axis: [0, 0, 1]}}]}\n",
+                 5, 27, "box.transform[0].rotate is missing required key 'angle'");
+  expectOneError(std::string(kMinimal) +
+                     "objects:\n  - {type: box, min: [0, 0, 0], max: [1, 1, 1],\n"
+                     "     transform: [{shear: 1}]}\n",
+                 5, 19,
+                 "unknown key 'shear' in a transform step; expected one of: translate, "
+                 "scale, rotate");
+}
+
+TEST(SceneParser, SeveralErrorsAllReportedInFileOrder) {
+  const std::vector<Diagnostic> errors = errorsOf(
+      "camera: {position: [0, 0], direction: [0, 0, -1], fov: 40}\n"
+      "image: {width: 4, height: x}\n"
+      "objects:\n"
+      "  - {type: sphere, center: [0, 0, 0], radius: -1}\n"
+      "  - {type: sphere, centre: [0, 0, 0], radius: 1}\n"
+      "lights:\n"
+      "  - {type: point, position: [0, 0, 0], intensity: -2}\n");
+  // The misspelt 'centre' is one error: the missing 'center' it stands for is not reported again.
+  ASSERT_EQ(errors.size(), 5u);
+  const std::vector<std::pair<int, int>> expected = {{1, 20}, {2, 27}, {4, 47}, {5, 20}, {7, 51}};
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    EXPECT_EQ(errors[i].where.line, expected[i].first) << errors[i].format();
+    EXPECT_EQ(errors[i].where.column, expected[i].second) << errors[i].format();
+  }
+  EXPECT_THAT(errors[2].message, HasSubstr("sphere.radius must be > 0, got -1"));
+  EXPECT_THAT(errors[3].message, HasSubstr("unknown key 'centre' in sphere"));
+  EXPECT_THAT(errors[3].message, HasSubstr("did you mean 'center'?"));
+  EXPECT_THAT(errors[4].message, HasSubstr("point light.intensity must be >= 0, got -2"));
+}
+
+TEST(SceneParser, AtMostTwentyErrorsReported) {
+  std::string text = kMinimal;
+  text += "objects:\n";
+  for (int i = 0; i < 25; ++i) text += "  - {type: sphere, center: [0, 0, 0], radius: -1}\n";
+  try {
+    loadSceneFromString(text, "t.yaml");
+    FAIL() << "expected a SceneError";
+  } catch (const SceneError& e) {
+    ASSERT_EQ(e.diagnostics().size(), SceneError::kMaxReportedErrors);
+    for (std::size_t i = 0; i < e.diagnostics().size(); ++i) {
+      EXPECT_EQ(e.diagnostics()[i].where.line, static_cast<int>(4 + i));
+    }
+    EXPECT_THAT(std::string(e.what()), HasSubstr("5 more errors not shown"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("t.yaml:4:47: sphere.radius must be > 0, got -1"));
+  }
+}
+
+TEST(SceneParser, DiagnosticFormats) {
+  const Diagnostic error{
+      Diagnostic::Severity::Error, {"scene.yaml", 14, 7}, "sphere.radius must be > 0, got -2"};
+  EXPECT_EQ(error.format(), "scene.yaml:14:7: sphere.radius must be > 0, got -2");
+  const Diagnostic warning{Diagnostic::Severity::Warning, {"a/b.yaml", 3, 1}, "zero intensity"};
+  EXPECT_EQ(warning.format(), "a/b.yaml:3:1: warning: zero intensity");
+  const Diagnostic fileOnly{Diagnostic::Severity::Error, {"scene.yaml", 0, 0}, "cannot open file"};
+  EXPECT_EQ(fileOnly.format(), "scene.yaml: cannot open file");
+}
+
+TEST(SceneParser, UnreadableFilesNameOnlyTheFile) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("glint_parser_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto firstError = [](const std::filesystem::path& p) -> Diagnostic {
+    try {
+      loadScene(p);
+    } catch (const SceneError& e) {
+      if (!e.diagnostics().empty()) return e.diagnostics()[0];
+    }
+    return {};
+  };
+  const Diagnostic missing = firstError(dir / "missing.yaml");
+  EXPECT_EQ(missing.format(),
+            (dir / "missing.yaml").string() + ": cannot open file: No such file or directory");
+  const Diagnostic directory = firstError(dir);
+  EXPECT_EQ(directory.format(), dir.string() + ": cannot open file: Is a directory");
+
+  // A readable file: relative paths are kept as given in messages.
+  { std::ofstream(dir / "bad.yaml") << kMinimal << "objects: 3\n"; }
+  const std::filesystem::path previous = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  const Diagnostic bad = firstError("bad.yaml");
+  const Diagnostic relativeMissing = firstError("scene.yaml");
+  std::filesystem::current_path(previous);
+  EXPECT_EQ(bad.format(), "bad.yaml:3:10: objects: expected a list of objects, got '3'");
+  EXPECT_EQ(relativeMissing.format(), "scene.yaml: cannot open file: No such file or directory");
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace glint

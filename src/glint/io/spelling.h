@@ -1,0 +1,64 @@
+// Did-you-mean suggestions for misspelt scene keys, types and material names (edit distance).
+#pragma once
+
+#include <algorithm>
+#include <cctype>
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace glint {
+
+// Edit distance between a and b ignoring ASCII case: insertions, deletions, substitutions and
+// transpositions of neighbours each count 1 (optimal string alignment, Damerau 1964), so "srbg" is
+// one edit from "srgb".
+inline std::size_t editDistance(std::string_view a, std::string_view b) {
+  const auto same = [&](std::size_t i, std::size_t j) {
+    return std::tolower(static_cast<unsigned char>(a[i])) ==
+           std::tolower(static_cast<unsigned char>(b[j]));
+  };
+  const std::size_t columns = b.size() + 1;
+  std::vector<std::size_t> d((a.size() + 1) * columns);
+  for (std::size_t i = 0; i <= a.size(); ++i) d[i * columns] = i;
+  for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      std::size_t best = std::min({d[(i - 1) * columns + j] + 1, d[i * columns + j - 1] + 1,
+                                   d[(i - 1) * columns + j - 1] + (same(i - 1, j - 1) ? 0 : 1)});
+      if (i > 1 && j > 1 && same(i - 1, j - 2) && same(i - 2, j - 1)) {
+        best = std::min(best, d[(i - 2) * columns + j - 2] + 1);
+      }
+      d[i * columns + j] = best;
+    }
+  }
+  return d[a.size() * columns + b.size()];
+}
+
+// The candidate closest to `word` when it is close enough to be a plausible typo (at most a third
+// of the longer word's letters differ, and at most 3), else empty.
+template <class Names>
+std::string closestName(std::string_view word, const Names& candidates) {
+  std::string best;
+  std::size_t bestDistance = 0;
+  for (const auto& candidate : candidates) {
+    const std::string_view name(candidate);
+    const std::size_t limit = std::min<std::size_t>(3, std::max(word.size(), name.size()) / 3);
+    const std::size_t d = editDistance(word, name);
+    if (word == name || d > std::max<std::size_t>(limit, 1)) continue;
+    if (best.empty() || d < bestDistance) {
+      best = std::string(name);
+      bestDistance = d;
+    }
+  }
+  return best;
+}
+
+// " (did you mean 'radius'?)" or "".
+template <class Names>
+std::string didYouMean(std::string_view word, const Names& candidates) {
+  const std::string best = closestName(word, candidates);
+  return best.empty() ? std::string() : " (did you mean '" + best + "'?)";
+}
+
+}  // namespace glint
