@@ -1,0 +1,103 @@
+#include "glint/cli/progress_reporter.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace glint::cli {
+namespace {
+
+constexpr auto kBarInterval = std::chrono::milliseconds(100);  // terminal redraw rate limit
+constexpr auto kLineInterval = std::chrono::seconds(2);        // log line rate when no 10% step
+constexpr int kBarCells = 30;
+
+int percentOf(std::size_t done, std::size_t total) {
+  return total == 0 ? 100 : static_cast<int>(done * 100 / total);
+}
+
+// Remaining time, extrapolated linearly from the tiles done so far; negative when unknown.
+double etaSeconds(std::size_t done, std::size_t total, double elapsed) {
+  if (done == 0 || total == 0) return -1;
+  return elapsed * static_cast<double>(total - done) / static_cast<double>(done);
+}
+
+std::string formatEta(double eta) { return eta < 0 ? std::string("--") : formatDuration(eta); }
+
+}  // namespace
+
+std::string formatDuration(double seconds) {
+  if (!(seconds >= 0)) seconds = 0;
+  if (seconds < 9.995) return fmt::format("{:.2f} s", seconds);
+  if (seconds < 59.95) return fmt::format("{:.1f} s", seconds);
+  const auto whole = static_cast<long long>(std::llround(seconds));
+  if (whole < 3600) return fmt::format("{} min {:02} s", whole / 60, whole % 60);
+  return fmt::format("{} h {:02} min", whole / 3600, (whole % 3600) / 60);
+}
+
+ProgressReporter::Style ProgressReporter::styleFor(std::FILE* stream) {
+  return isatty(fileno(stream)) ? Style::Bar : Style::Lines;
+}
+
+ProgressReporter::ProgressReporter(Style style, std::FILE* stream)
+    : style_(style), stream_(stream), start_(Clock::now()), lastDraw_(start_) {}
+
+void ProgressReporter::start() {
+  start_ = lastDraw_ = Clock::now();
+  lastDecile_ = 0;
+  if (style_ == Style::Bar) drawBar(0, 1, 0);
+}
+
+double ProgressReporter::elapsedSeconds() const {
+  return std::chrono::duration<double>(Clock::now() - start_).count();
+}
+
+void ProgressReporter::update(std::size_t done, std::size_t total) {
+  if (style_ == Style::Silent) return;
+  const auto now = Clock::now();
+  const double elapsed = elapsedSeconds();
+  if (style_ == Style::Bar) {
+    if (done == total || now - lastDraw_ >= kBarInterval) {
+      drawBar(done, total, elapsed);
+      lastDraw_ = now;
+    }
+    return;
+  }
+  const int decile = percentOf(done, total) / 10;
+  if (decile > lastDecile_ || now - lastDraw_ >= kLineInterval) {
+    if (lastPrinted100_) return;  // never repeat the final line
+    printLine(done, total, elapsed);
+    lastDecile_ = std::max(decile, lastDecile_);
+    lastDraw_ = now;
+    lastPrinted100_ = done == total;
+  }
+}
+
+void ProgressReporter::finish() {
+  if (style_ == Style::Bar && barDrawn_) {
+    std::fputc('\n', stream_);
+    std::fflush(stream_);
+    barDrawn_ = false;
+  }
+}
+
+void ProgressReporter::drawBar(std::size_t done, std::size_t total, double elapsed) {
+  const int percent = percentOf(done, total);
+  const int filled = percent * kBarCells / 100;
+  std::string bar(static_cast<std::size_t>(filled), '#');
+  bar.append(static_cast<std::size_t>(kBarCells - filled), '.');
+  // Trailing blanks overwrite the end of a longer previous line (an ETA in minutes, say).
+  fmt::print(stream_, "\rglint: [{}] {:3}%  elapsed {}  ETA {}      ", bar, percent,
+             formatDuration(elapsed), formatEta(etaSeconds(done, total, elapsed)));
+  std::fflush(stream_);
+  barDrawn_ = true;
+}
+
+void ProgressReporter::printLine(std::size_t done, std::size_t total, double elapsed) {
+  fmt::print(stream_, "glint: {}% (elapsed {}, ETA {})\n", percentOf(done, total),
+             formatDuration(elapsed), formatEta(etaSeconds(done, total, elapsed)));
+  std::fflush(stream_);
+}
+
+}  // namespace glint::cli

@@ -1,0 +1,60 @@
+#include "glint/cli/signal_guard.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <array>
+
+namespace glint::cli {
+namespace {
+
+// Process-wide state touched from the signal handler: lock-free atomics only (async-signal-safe).
+std::atomic<bool> gCancel{false};
+std::atomic<int> gSignal{0};
+std::atomic<bool> gCommitting{false};
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free);
+
+constexpr std::array<int, 2> kHandledSignals{SIGINT, SIGTERM};
+std::array<struct sigaction, 2> gPrevious{};
+
+extern "C" void onStopSignal(int signal) {
+  int expected = 0;
+  if (gSignal.compare_exchange_strong(expected, signal)) {
+    gCancel.store(true);
+    return;
+  }
+  // A second signal: the user insists. Only write(2) and _exit(2) here (async-signal-safe).
+  if (gCommitting.load()) return;
+  static constexpr char kMessage[] = "\nglint: interrupted\n";
+  [[maybe_unused]] const ssize_t written = write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+  _exit(SignalGuard::exitCodeFor(expected));
+}
+
+}  // namespace
+
+SignalGuard::SignalGuard() {
+  gCancel.store(false);
+  gSignal.store(0);
+  gCommitting.store(false);
+  struct sigaction action {};
+  action.sa_handler = onStopSignal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART;  // file I/O of other threads carries on; the flag is polled
+  for (std::size_t i = 0; i < kHandledSignals.size(); ++i) {
+    sigaction(kHandledSignals[i], &action, &gPrevious[i]);
+  }
+}
+
+SignalGuard::~SignalGuard() {
+  for (std::size_t i = 0; i < kHandledSignals.size(); ++i) {
+    sigaction(kHandledSignals[i], &gPrevious[i], nullptr);
+  }
+}
+
+const std::atomic<bool>& SignalGuard::cancelFlag() const { return gCancel; }
+
+int SignalGuard::receivedSignal() const { return gSignal.load(); }
+
+void SignalGuard::setCommitting(bool committing) { gCommitting.store(committing); }
+
+}  // namespace glint::cli

@@ -1,0 +1,30 @@
+// SIGINT/SIGTERM handling for a render: the first signal asks the renderer to stop (a flag it polls
+// between tiles); a second one ends the process at once, unless the image is being committed.
+#pragma once
+
+#include <atomic>
+
+namespace glint::cli {
+
+// Installs the handlers (sigaction) for its lifetime and restores the previous ones afterwards.
+// Only one may exist at a time: the handlers share process-wide state.
+class SignalGuard {
+ public:
+  SignalGuard();
+  ~SignalGuard();
+  SignalGuard(const SignalGuard&) = delete;
+  SignalGuard& operator=(const SignalGuard&) = delete;
+
+  // Set by the first SIGINT/SIGTERM; give it to RenderOptions::cancel.
+  const std::atomic<bool>& cancelFlag() const;
+  // The first signal received, or 0.
+  int receivedSignal() const;
+  // The exit status for a run stopped by `signal`: 128 + signal (130 for SIGINT, 143 for SIGTERM).
+  static int exitCodeFor(int signal) { return 128 + signal; }
+
+  // While committing (writing the finished image: temporary file, then rename), a second signal
+  // no longer ends the process, so no temporary file can be left behind.
+  void setCommitting(bool committing);
+};
+
+}  // namespace glint::cli

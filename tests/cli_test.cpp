@@ -1,0 +1,746 @@
+// The glint command line (DESIGN.md §6, §7), tested by running the built binary: exit statuses,
+// error positions for broken scene files, output files (never partial), overrides, crops, thread
+// independence, signals and progress output.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+const fs::path kGlint = fs::path(GLINT_BINARY_DIR) / "glint";
+const fs::path kScenes = fs::path(GLINT_SOURCE_DIR) / "tests" / "cli";
+const fs::path kBroken = kScenes / "broken";
+
+// An exit status, or kKilledBy + signal when the process did not exit by itself (a crash, or a
+// signal it did not handle), so that "exited with 130" and "died of SIGINT" stay distinguishable.
+constexpr int kKilledBy = 1000;
+
+int decodeStatus(int status) {
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) return kKilledBy + WTERMSIG(status);
+  return -1;
+}
+
+std::string readFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void writeFile(const fs::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+std::set<std::string> filesIn(const fs::path& folder) {
+  std::set<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder)) names.insert(entry.path().filename());
+  return names;
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+struct RunResult {
+  int status = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+// Child side of a run: cwd `work`, stdin /dev/null, stdout/stderr to the given descriptors.
+[[noreturn]] void execGlint(const std::vector<std::string>& args, const fs::path& work, int outFd,
+                            int errFd) {
+  std::vector<char*> argv;
+  std::string program = kGlint.string();
+  argv.push_back(program.data());
+  std::vector<std::string> copies = args;
+  for (std::string& arg : copies) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  const int in = open("/dev/null", O_RDONLY);
+  if (in < 0 || dup2(in, STDIN_FILENO) < 0 || dup2(outFd, STDOUT_FILENO) < 0 ||
+      dup2(errFd, STDERR_FILENO) < 0 || chdir(work.c_str()) != 0)
+    _exit(127);
+  execv(argv[0], argv.data());
+  _exit(127);
+}
+
+// Polls waitpid until the child ends; kills it after `timeout` (then the status is the kill).
+int waitFor(pid_t pid, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      ADD_FAILURE() << "glint did not finish within " << timeout.count() << " ms";
+      return -1;
+    }
+    std::this_thread::sleep_for(5ms);
+  }
+  return decodeStatus(status);
+}
+
+// Whether `pid` has a handler installed for `signal` (the SigCgt mask of /proc/PID/status).
+bool catchesSignal(pid_t pid, int signal) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("SigCgt:", 0) == 0) {
+      const std::uint64_t mask = std::stoull(line.substr(7), nullptr, 16);
+      return (mask >> (signal - 1)) & 1;
+    }
+  }
+  return false;
+}
+
+// Reads an 8-bit binary PPM (P6): width, height and the RGB bytes.
+struct Ppm {
+  int width = 0, height = 0;
+  std::string rgb;
+};
+
+Ppm readPpm(const fs::path& path) {
+  const std::string bytes = readFile(path);
+  std::size_t pos = 0;
+  auto token = [&]() {
+    while (pos < bytes.size()) {
+      if (bytes[pos] == '#') {
+        while (pos < bytes.size() && bytes[pos] != '\n') ++pos;
+      } else if (std::isspace(static_cast<unsigned char>(bytes[pos]))) {
+        ++pos;
+      } else {
+        break;
+      }
+    }
+    const std::size_t start = pos;
+    while (pos < bytes.size() && !std::isspace(static_cast<unsigned char>(bytes[pos]))) ++pos;
+    return bytes.substr(start, pos - start);
+  };
+  Ppm ppm;
+  if (token() != "P6") return ppm;
+  ppm.width = std::stoi(token());
+  ppm.height = std::stoi(token());
+  if (token() != "255") return {};
+  ++pos;  // the single whitespace byte before the raster
+  ppm.rgb = bytes.substr(pos);
+  return ppm;
+}
+
+// Width and height from a PNG's IHDR chunk (bytes 16–23, big-endian), after checking the signature.
+std::optional<std::pair<std::uint32_t, std::uint32_t>> pngSize(const fs::path& path) {
+  const std::string bytes = readFile(path);
+  static const std::string kSignature("\x89PNG\r\n\x1a\n", 8);
+  if (bytes.size() < 24 || bytes.compare(0, 8, kSignature) != 0 || bytes.compare(12, 4, "IHDR"))
+    return std::nullopt;
+  auto be32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(bytes[at + i]);
+    return v;
+  };
+  return std::make_pair(be32(16), be32(20));
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "glint-cli-XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    root_ = pattern;
+    work_ = root_ / "work";
+    fs::create_directory(work_);
+    fs::create_directory(root_ / "capture");
+    ASSERT_TRUE(fs::exists(kGlint)) << "build the glint_cli target first: " << kGlint;
+  }
+  void TearDown() override {
+    if (running_ > 0) {
+      kill(running_, SIGKILL);
+      waitpid(running_, nullptr, 0);
+    }
+    std::error_code ignored;
+    fs::remove_all(root_, ignored);
+  }
+
+  // Runs glint to the end in the work folder.
+  RunResult run(const std::vector<std::string>& args, std::chrono::milliseconds timeout = 60s) {
+    const fs::path outPath = root_ / "capture" / "stdout";
+    const fs::path errPath = root_ / "capture" / "stderr";
+    const int outFd = open(outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int errFd = open(errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    RunResult result;
+    const pid_t pid = fork();
+    if (pid == 0) execGlint(args, work_, outFd, errFd);
+    close(outFd);
+    close(errFd);
+    if (pid < 0) {
+      ADD_FAILURE() << "fork failed";
+      return result;
+    }
+    result.status = waitFor(pid, timeout);
+    result.out = readFile(outPath);
+    result.err = readFile(errPath);
+    return result;
+  }
+
+  // Starts glint in the background (stdout/stderr captured to files); see finish().
+  pid_t start(const std::vector<std::string>& args) {
+    const int outFd =
+        open((root_ / "capture" / "stdout").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int errFd =
+        open((root_ / "capture" / "stderr").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const pid_t pid = fork();
+    if (pid == 0) execGlint(args, work_, outFd, errFd);
+    close(outFd);
+    close(errFd);
+    running_ = pid;
+    return pid;
+  }
+
+  RunResult finish(pid_t pid, std::chrono::milliseconds timeout) {
+    RunResult result;
+    result.status = waitFor(pid, timeout);
+    running_ = 0;
+    result.out = readFile(root_ / "capture" / "stdout");
+    result.err = readFile(root_ / "capture" / "stderr");
+    return result;
+  }
+
+  // Starts the heavy render, waits until it handles `signal`, lets it render a moment, sends it.
+  RunResult interruptHeavyRender(int signal, const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> args{"render", (kScenes / "heavy.yaml").string(), "-o", "out.png"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const pid_t pid = start(args);
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while (!catchesSignal(pid, signal) && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(2ms);
+    EXPECT_TRUE(catchesSignal(pid, signal)) << "glint never installed its signal handler";
+    std::this_thread::sleep_for(300ms);
+    kill(pid, signal);
+    return finish(pid, 30s);
+  }
+
+  std::string small() const { return (kScenes / "small.yaml").string(); }
+
+  fs::path root_;
+  fs::path work_;
+  pid_t running_ = 0;
+};
+
+// --- exit statuses and basic output ---------------------------------------------------------
+
+TEST_F(Cli, RenderWritesAPngAndExitsZero) {
+  const RunResult r = run({"render", small(), "-o", "out.png"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto size = pngSize(work_ / "out.png");
+  ASSERT_TRUE(size.has_value()) << "not a PNG";
+  EXPECT_EQ(size->first, 32u);
+  EXPECT_EQ(size->second, 24u);
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{"out.png"}) << "a temporary file was left";
+  EXPECT_EQ(r.out, "");
+}
+
+TEST_F(Cli, DefaultOutputIsTheSceneNameWithPngInTheCurrentFolder) {
+  const RunResult r = run({"render", small(), "--quiet"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{"small.png"});
+  EXPECT_TRUE(pngSize(work_ / "small.png").has_value());
+}
+
+TEST_F(Cli, PpmAndExrOutputsFollowTheExtension) {
+  ASSERT_EQ(run({"render", small(), "-o", "out.ppm", "--quiet"}).status, 0);
+  const Ppm ppm = readPpm(work_ / "out.ppm");
+  EXPECT_EQ(ppm.width, 32);
+  EXPECT_EQ(ppm.height, 24);
+  EXPECT_EQ(ppm.rgb.size(), 32u * 24u * 3u);
+  ASSERT_EQ(run({"render", small(), "-o", "out.exr", "--quiet"}).status, 0);
+  // OpenEXR magic number 20000630, little-endian.
+  EXPECT_EQ(readFile(work_ / "out.exr").substr(0, 4), std::string("\x76\x2f\x31\x01", 4));
+}
+
+TEST_F(Cli, HelpAndVersionExitZero) {
+  RunResult r = run({"--help"});
+  EXPECT_EQ(r.status, 0);
+  EXPECT_TRUE(contains(r.out, "render")) << r.out;
+  EXPECT_TRUE(contains(r.out, "check")) << r.out;
+  r = run({"render", "--help"});
+  EXPECT_EQ(r.status, 0);
+  EXPECT_TRUE(contains(r.out, "--crop")) << r.out;
+  EXPECT_TRUE(contains(r.out, "--threads")) << r.out;
+  r = run({"--version"});
+  EXPECT_EQ(r.status, 0);
+  EXPECT_TRUE(contains(r.out, GLINT_VERSION)) << r.out;
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
+TEST_F(Cli, ArgumentParserErrorsExitTwo) {
+  RunResult r = run({"render", small(), "--bogus", "-o", "out.png"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "--bogus")) << r.err;
+  EXPECT_EQ(run({}).status, 2);  // no command
+  r = run({"draw", small()});    // unknown command
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "draw")) << r.err;
+  EXPECT_EQ(run({"render"}).status, 2);                      // no scene
+  EXPECT_EQ(run({"render", small(), small()}).status, 2);    // two scenes
+  EXPECT_EQ(run({"render", small(), "--width"}).status, 2);  // missing value
+  r = run({"render", small(), "--width", "abc"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "--width")) << r.err;
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
+TEST_F(Cli, OutOfRangeOptionsExitTwoBeforeRendering) {
+  const std::vector<std::vector<std::string>> cases{{"--samples", "0"},
+                                                    {"--samples", "65537"},
+                                                    {"--threads", "0"},
+                                                    {"--threads", "-3"},
+                                                    {"--width", "0"},
+                                                    {"--height", "-1"},
+                                                    {"--width", "70000"},
+                                                    {"--height", "65536"},
+                                                    {"--width", "65535"},
+                                                    {"--seed", "-1"},
+                                                    {"--crop", "0,0,33,24"},
+                                                    {"--crop", "0,0,32,25"},
+                                                    {"--crop", "5,0,5,24"},
+                                                    {"--crop", "0,10,32,4"},
+                                                    {"--crop", "-1,0,8,8"},
+                                                    {"--crop", "1,2,3"},
+                                                    {"--crop", "a,b,c,d"},
+                                                    {"--crop", "0,0,8,8,9"},
+                                                    {"--crop", "0,0,40,30", "--width", "32"}};
+  for (const auto& extra : cases) {
+    std::vector<std::string> args{"render", small(), "-o", "out.png"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const RunResult r = run(args);
+    EXPECT_EQ(r.status, 2) << extra[0] << " " << extra[1] << "\n" << r.err;
+    EXPECT_TRUE(contains(r.err, extra[0])) << extra[0] << " " << extra[1] << ": " << r.err;
+    EXPECT_TRUE(filesIn(work_).empty()) << extra[0] << " " << extra[1];
+  }
+}
+
+TEST_F(Cli, MissingSceneFileExitsTwoNamingIt) {
+  const RunResult r = run({"render", "no-such-scene.yaml", "-o", "out.png"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "no-such-scene.yaml")) << r.err;
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
+TEST_F(Cli, SceneThatIsAFolderExitsTwoNamingIt) {
+  const RunResult r = run({"check", kBroken.string()});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, kBroken.string())) << r.err;
+}
+
+TEST_F(Cli, CheckPrintsASummaryAndWritesNothing) {
+  const RunResult r = run({"check", small()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "cli small")) << r.out;
+  EXPECT_TRUE(contains(r.out, "32x24")) << r.out;
+  EXPECT_TRUE(contains(r.out, "objects:   4 (3 bounded, 1 unbounded)")) << r.out;
+  EXPECT_TRUE(contains(r.out, "lights:    2 + ambient")) << r.out;
+  EXPECT_TRUE(contains(r.out, "materials:")) << r.out;
+  EXPECT_TRUE(contains(r.out, "bounds:")) << r.out;
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
+TEST_F(Cli, CheckReportsTheSameErrorsAsRender) {
+  const std::string scene = (kBroken / "negative_radius.yaml").string();
+  const RunResult check = run({"check", scene});
+  const RunResult render = run({"render", scene, "-o", "out.png"});
+  EXPECT_EQ(check.status, 2);
+  EXPECT_EQ(render.status, 2);
+  EXPECT_TRUE(contains(check.err, "negative_radius.yaml:12:13")) << check.err;
+  EXPECT_EQ(check.err, render.err);
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
+// --- broken scene files ---------------------------------------------------------------------
+
+struct BrokenScene {
+  const char* file;
+  const char* position;  // LINE:COL of the key or value at fault (1:1 when there is no place)
+  std::vector<std::string> fragments;  // each must appear in the message
+};
+
+// One file per error class of DESIGN.md §5 and §7.
+const std::vector<BrokenScene> kBrokenScenes{
+    {"unknown_top_level_key.yaml", "9:1", {"colour"}},
+    {"misspelt_object_key.yaml", "12:5", {"raduis"}},
+    {"wrong_type.yaml", "7:10", {"width"}},
+    {"missing_camera.yaml", "1:1", {"camera"}},
+    {"missing_image.yaml", "1:1", {"image"}},
+    {"negative_radius.yaml", "12:13", {"radius", "-2"}},
+    {"zero_length_direction.yaml", "4:14", {"direction"}},
+    {"up_parallel_to_direction.yaml", "5:7", {"up", "parallel"}},
+    {"width_zero.yaml", "7:10", {"width"}},
+    {"width_too_large.yaml", "7:10", {"70000"}},
+    {"samples_zero.yaml", "9:12", {"samples"}},
+    {"fov_180.yaml", "5:8", {"fov"}},
+    {"direction_and_look_at.yaml", "5:3", {"direction", "look_at"}},
+    {"view_plane_and_fov.yaml", "6:3", {"view_plane", "fov"}},
+    {"undefined_material.yaml", "12:61", {"chrome"}},
+    {"duplicate_key.yaml", "13:5", {"radius"}},
+    {"two_documents.yaml", "9:1", {"document"}},
+    {"nan_value.yaml", "10:52", {"intensity"}},
+    {"infinite_value.yaml", "5:48", {"distance"}},
+    {"collinear_triangle.yaml", "11:15", {"collinear"}},
+    {"non_planar_polygon.yaml", "11:15", {"planar"}},
+    {"non_convex_polygon.yaml", "11:15", {"convex"}},
+    {"rectangle_edges_not_perpendicular.yaml", "12:12", {"perpendicular"}},
+    {"attenuation_all_zero.yaml", "12:18", {"attenuation"}},
+    {"bad_color_string.yaml", "9:13", {"background"}},
+    {"unknown_object_type.yaml", "10:11", {"pyramid"}},
+    {"unknown_light_type.yaml", "10:11", {"laser"}},
+    {"mesh_object.yaml", "10:5", {"mesh"}},
+    {"syntax_error.yaml", "3:22", {"syntax"}},
+    {"empty_file.yaml", "1:1", {"empty"}},
+    {"negative_kd.yaml", "10:15", {"kd"}},
+    {"ior_zero.yaml", "12:10", {"ior"}},
+    {"missing_object_key.yaml", "10:5", {"radius"}},
+    {"max_depth_zero.yaml", "10:14", {"max_depth"}},
+    {"unknown_transform_step.yaml", "15:11", {"skew"}},
+    {"unknown_encoding.yaml", "9:13", {"gamma"}},
+    {"triangle_four_vertices.yaml", "11:15", {"vertices"}},
+    {"negative_intensity.yaml", "11:14", {"intensity"}},
+    {"objects_not_a_list.yaml", "9:10", {"objects"}},
+    {"negative_min_weight.yaml", "10:15", {"min_weight"}},
+    {"grid_interval_zero.yaml", "9:21", {"interval"}},
+};
+
+TEST_F(Cli, BrokenScenesExitTwoNamingFileLineAndColumn) {
+  for (const BrokenScene& broken : kBrokenScenes) {
+    SCOPED_TRACE(broken.file);
+    const RunResult r = run({"render", (kBroken / broken.file).string(), "-o", "out.png"});
+    EXPECT_EQ(r.status, 2) << r.err;
+    const std::string where = std::string(broken.file) + ":" + broken.position + ":";
+    EXPECT_TRUE(contains(r.err, where)) << "expected " << where << " in:\n" << r.err;
+    for (const std::string& fragment : broken.fragments)
+      EXPECT_TRUE(contains(r.err, fragment)) << "expected '" << fragment << "' in:\n" << r.err;
+    // No library jargon and no crash report.
+    for (const char* jargon : {"YAML::", "yaml-cpp", "terminate", "what()", "std::", "Assertion"})
+      EXPECT_FALSE(contains(r.err, jargon)) << r.err;
+    EXPECT_TRUE(filesIn(work_).empty()) << "a failed run left a file behind";
+  }
+}
+
+TEST_F(Cli, EveryBrokenFileIsInTheTable) {
+  std::set<std::string> listed;
+  for (const BrokenScene& broken : kBrokenScenes) listed.insert(broken.file);
+  EXPECT_EQ(listed.size(), kBrokenScenes.size()) << "a file is listed twice";
+  EXPECT_GE(listed.size(), 25u);
+  EXPECT_EQ(filesIn(kBroken), listed);
+}
+
+TEST_F(Cli, EveryErrorOfAFileIsReported) {
+  const RunResult r = run({"check", (kScenes / "several_errors.yaml").string()});
+  EXPECT_EQ(r.status, 2);
+  for (const char* where :
+       {"several_errors.yaml:10:48:", "several_errors.yaml:11:48:", "several_errors.yaml:13:52:"})
+    EXPECT_TRUE(contains(r.err, where)) << "expected " << where << " in:\n" << r.err;
+}
+
+TEST_F(Cli, WarningsArePrintedButDoNotChangeTheExitStatus) {
+  const std::string scene = (kScenes / "zero_light.yaml").string();
+  RunResult r = run({"render", scene, "-o", "out.png"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "zero_light.yaml:12:5: warning: ")) << r.err;
+  EXPECT_TRUE(contains(r.err, "intensity")) << r.err;
+  EXPECT_TRUE(pngSize(work_ / "out.png").has_value());
+  r = run({"check", scene});
+  EXPECT_EQ(r.status, 0);
+  EXPECT_TRUE(contains(r.err, "zero_light.yaml:12:5: warning: ")) << r.err;
+  r = run({"render", scene, "-o", "out.png", "--quiet"});
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.err, "") << "--quiet prints errors only";
+}
+
+// --- output files are never broken ----------------------------------------------------------
+
+TEST_F(Cli, ExistingOutputIsUntouchedAfterABadScene) {
+  const std::string precious = "not an image, but mine\n";
+  writeFile(work_ / "out.png", precious);
+  const RunResult r = run({"render", (kBroken / "negative_radius.yaml").string(), "-o", "out.png"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(readFile(work_ / "out.png"), precious);
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{"out.png"});
+}
+
+TEST_F(Cli, UnknownOutputExtensionExitsTwoAndTouchesNothing) {
+  const std::string precious = "BM not really a bitmap\n";
+  writeFile(work_ / "out.bmp", precious);
+  RunResult r = run({"render", small(), "-o", "out.bmp"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "out.bmp")) << r.err;
+  EXPECT_TRUE(contains(r.err, ".png")) << "should say which formats exist: " << r.err;
+  EXPECT_EQ(readFile(work_ / "out.bmp"), precious);
+  r = run({"render", small(), "-o", "out"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{"out.bmp"});
+}
+
+TEST_F(Cli, MissingOutputFolderExitsTwo) {
+  const RunResult r = run({"render", small(), "-o", "no-such-folder/out.png"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "no-such-folder")) << r.err;
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
+TEST_F(Cli, OutputPathThatIsAFolderIsAWriteFailure) {
+  fs::create_directory(work_ / "out.png");
+  const RunResult r = run({"render", small(), "-o", "out.png"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(contains(r.err, "out.png")) << r.err;
+  EXPECT_TRUE(fs::is_empty(work_ / "out.png"));
+}
+
+// --- overrides ------------------------------------------------------------------------------
+
+TEST_F(Cli, WidthOrHeightAloneKeepsTheAspect) {
+  struct Case {
+    std::vector<std::string> options;
+    std::uint32_t width, height;
+  };
+  const std::vector<Case> cases{{{"--width", "64"}, 64, 48},
+                                {{"--height", "12"}, 16, 12},
+                                {{"--width", "10"}, 10, 8},  // 7.5 rounds to 8
+                                {{"--width", "1"}, 1, 1},    // 0.75 rounds to 1
+                                {{"--width", "20", "--height", "30"}, 20, 30}};
+  for (const Case& c : cases) {
+    std::vector<std::string> args{"render", small(), "-o", "out.png", "--quiet", "--samples", "1"};
+    args.insert(args.end(), c.options.begin(), c.options.end());
+    ASSERT_EQ(run(args).status, 0);
+    const auto size = pngSize(work_ / "out.png");
+    ASSERT_TRUE(size.has_value());
+    EXPECT_EQ(size->first, c.width) << c.options[0] << " " << c.options[1];
+    EXPECT_EQ(size->second, c.height) << c.options[0] << " " << c.options[1];
+  }
+}
+
+TEST_F(Cli, CropsStitchedTogetherEqualTheFullImageByteForByte) {
+  ASSERT_EQ(run({"render", small(), "-o", "full.ppm", "--quiet"}).status, 0);
+  const Ppm full = readPpm(work_ / "full.ppm");
+  ASSERT_EQ(full.width, 32);
+  ASSERT_EQ(full.height, 24);
+  // Split off the 16-pixel tile grid on purpose: 13 and 10 are not tile boundaries.
+  struct Quadrant {
+    int x0, y0, x1, y1;
+  };
+  const std::vector<Quadrant> quadrants{
+      {0, 0, 13, 10}, {13, 0, 32, 10}, {0, 10, 13, 24}, {13, 10, 32, 24}};
+  std::string stitched(full.rgb.size(), '\0');
+  for (const Quadrant& q : quadrants) {
+    const std::string crop = std::to_string(q.x0) + "," + std::to_string(q.y0) + "," +
+                             std::to_string(q.x1) + "," + std::to_string(q.y1);
+    ASSERT_EQ(run({"render", small(), "-o", "crop.ppm", "--quiet", "--crop", crop}).status, 0);
+    const Ppm part = readPpm(work_ / "crop.ppm");
+    ASSERT_EQ(part.width, q.x1 - q.x0) << crop;
+    ASSERT_EQ(part.height, q.y1 - q.y0) << crop;
+    ASSERT_EQ(part.rgb.size(), static_cast<std::size_t>(part.width * part.height * 3));
+    for (int y = 0; y < part.height; ++y)
+      stitched.replace(static_cast<std::size_t>(((q.y0 + y) * full.width + q.x0) * 3),
+                       static_cast<std::size_t>(part.width * 3),
+                       part.rgb.substr(static_cast<std::size_t>(y * part.width * 3),
+                                       static_cast<std::size_t>(part.width * 3)));
+  }
+  EXPECT_TRUE(stitched == full.rgb) << "the crops differ from the full render";
+}
+
+TEST_F(Cli, MemoryBudgetCountsOnlyTheCropThatIsRendered) {
+  // The full 65535-pixel-wide image would not fit in memory; a 32x24 piece of it does.
+  RunResult r = run({"render", small(), "-o", "out.png", "--width", "65535", "--samples", "1"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "--width 65535")) << r.err;
+  r = run({"render", small(), "-o", "out.png", "--width", "65535", "--samples", "1", "--quiet",
+           "--crop", "30000,20000,30032,20024"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto size = pngSize(work_ / "out.png");
+  ASSERT_TRUE(size.has_value());
+  EXPECT_EQ(size->first, 32u);
+  EXPECT_EQ(size->second, 24u);
+}
+
+TEST_F(Cli, ThreadCountDoesNotChangeTheBytes) {
+  ASSERT_EQ(run({"render", small(), "-o", "one.png", "--quiet", "--threads", "1"}).status, 0);
+  ASSERT_EQ(run({"render", small(), "-o", "two.png", "--quiet", "--threads", "2"}).status, 0);
+  ASSERT_EQ(run({"render", small(), "-o", "all.png", "--quiet"}).status, 0);
+  const std::string one = readFile(work_ / "one.png");
+  EXPECT_FALSE(one.empty());
+  EXPECT_TRUE(one == readFile(work_ / "two.png"));
+  EXPECT_TRUE(one == readFile(work_ / "all.png"));
+}
+
+TEST_F(Cli, SeedReplacesTheScenesSeed) {
+  // small.yaml has render.seed 7 and glossy reflections, so the seed shows in the pixels.
+  ASSERT_EQ(run({"render", small(), "-o", "scene.ppm", "--quiet"}).status, 0);
+  ASSERT_EQ(run({"render", small(), "-o", "seven.ppm", "--quiet", "--seed", "7"}).status, 0);
+  ASSERT_EQ(run({"render", small(), "-o", "eight.ppm", "--quiet", "--seed", "8"}).status, 0);
+  const std::string scene = readFile(work_ / "scene.ppm");
+  EXPECT_TRUE(scene == readFile(work_ / "seven.ppm"));
+  EXPECT_FALSE(scene == readFile(work_ / "eight.ppm"));
+}
+
+TEST_F(Cli, SamplesOverrideChangesTheImage) {
+  ASSERT_EQ(run({"render", small(), "-o", "four.ppm", "--quiet"}).status, 0);
+  ASSERT_EQ(run({"render", small(), "-o", "one.ppm", "--quiet", "--samples", "1"}).status, 0);
+  EXPECT_FALSE(readFile(work_ / "four.ppm") == readFile(work_ / "one.ppm"));
+}
+
+// --- signals --------------------------------------------------------------------------------
+
+TEST_F(Cli, SigintStopsTheRenderWith130AndWritesNothing) {
+  const RunResult r = interruptHeavyRender(SIGINT);
+  EXPECT_EQ(r.status, 130) << r.err;
+  EXPECT_TRUE(contains(r.err, "glint: interrupted")) << r.err;
+  EXPECT_TRUE(filesIn(work_).empty()) << "an output or temporary file was left";
+}
+
+TEST_F(Cli, SecondSigintEndsTheRenderAtOnceAndWritesNothing) {
+  const pid_t pid = start({"render", (kScenes / "heavy.yaml").string(), "-o", "out.png"});
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (!catchesSignal(pid, SIGINT) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(2ms);
+  std::this_thread::sleep_for(300ms);
+  kill(pid, SIGINT);
+  std::this_thread::sleep_for(1ms);
+  kill(pid, SIGINT);
+  const RunResult r = finish(pid, 30s);
+  EXPECT_EQ(r.status, 130) << r.err;
+  EXPECT_TRUE(contains(r.err, "glint: interrupted")) << r.err;
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
+TEST_F(Cli, SigtermStopsTheRenderWith143AndKeepsTheExistingOutput) {
+  const std::string precious = "the previous image\n";
+  writeFile(work_ / "out.png", precious);
+  const RunResult r = interruptHeavyRender(SIGTERM, {"--quiet"});
+  EXPECT_EQ(r.status, 143) << r.err;
+  EXPECT_EQ(readFile(work_ / "out.png"), precious);
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{"out.png"});
+}
+
+// --- progress and summary -------------------------------------------------------------------
+
+TEST_F(Cli, ProgressIsPlainPercentLinesWhenNotATerminal) {
+  // 96x72 pixels: several tiles for any sensible tile size, so several progress steps.
+  const RunResult r = run({"render", small(), "-o", "out.png", "--width", "96"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::regex line(R"(glint: (\d+)% \(elapsed [0-9.]+ s, ETA (--|[0-9.]+ s)\))");
+  int lines = 0, last = -1;
+  std::istringstream in(r.err);
+  for (std::string text; std::getline(in, text);) {
+    std::smatch m;
+    if (!std::regex_match(text, m, line)) continue;
+    const int percent = std::stoi(m[1]);
+    EXPECT_GT(percent, last) << "percentages go up";
+    last = percent;
+    ++lines;
+  }
+  EXPECT_GE(lines, 2) << r.err;
+  EXPECT_EQ(last, 100) << r.err;
+  EXPECT_FALSE(contains(r.err, "\r")) << "no terminal control characters in logs";
+  // The summary: time, rays by kind, Mrays/s.
+  for (const char* part : {"camera", "shadow", "reflection", "refraction", "Mrays/s", "out.png"})
+    EXPECT_TRUE(contains(r.err, part)) << part << " missing in:\n" << r.err;
+  EXPECT_FALSE(contains(r.err, "non-finite")) << "details only with --stats";
+}
+
+TEST_F(Cli, QuietPrintsNothingOnSuccess) {
+  const RunResult r = run({"render", small(), "-o", "out.png", "--quiet"});
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.err, "");
+  EXPECT_EQ(r.out, "");
+  EXPECT_TRUE(fs::exists(work_ / "out.png"));
+}
+
+TEST_F(Cli, QuietStillPrintsErrors) {
+  const RunResult r = run({"render", (kBroken / "negative_radius.yaml").string(), "--quiet"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "negative_radius.yaml:12:13")) << r.err;
+}
+
+TEST_F(Cli, StatsAddsDetails) {
+  const RunResult r = run({"render", small(), "-o", "out.png", "--stats", "--threads", "2"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* part :
+       {"4 primitives", "4 samples per pixel", "2 threads", "non-finite samples: 0"})
+    EXPECT_TRUE(contains(r.err, part)) << part << " missing in:\n" << r.err;
+}
+
+TEST_F(Cli, ProgressIsABarRedrawnInPlaceOnATerminal) {
+  const int master = posix_openpt(O_RDWR | O_NOCTTY);
+  ASSERT_GE(master, 0);
+  ASSERT_EQ(grantpt(master), 0);
+  ASSERT_EQ(unlockpt(master), 0);
+  const std::string slaveName = ptsname(master);
+  const int slave = open(slaveName.c_str(), O_RDWR | O_NOCTTY);
+  ASSERT_GE(slave, 0);
+  // Raw mode: the terminal must not turn "\n" into "\r\n", so every '\r' seen is glint's own.
+  termios mode{};
+  ASSERT_EQ(tcgetattr(slave, &mode), 0);
+  cfmakeraw(&mode);
+  ASSERT_EQ(tcsetattr(slave, TCSANOW, &mode), 0);
+  const int outFd =
+      open((root_ / "capture" / "stdout").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(master);
+    execGlint({"render", small(), "-o", "out.png"}, work_, outFd, slave);
+  }
+  close(slave);
+  close(outFd);
+  // Drain the terminal while glint runs, so it never blocks on a full pty buffer.
+  std::string err;
+  int status = -1;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  for (bool exited = false;;) {
+    pollfd fd{master, POLLIN, 0};
+    if (poll(&fd, 1, 20) > 0) {
+      char buffer[4096];
+      const ssize_t n = read(master, buffer, sizeof buffer);
+      if (n > 0) {
+        err.append(buffer, static_cast<std::size_t>(n));
+        continue;
+      }
+    }
+    if (exited) break;
+    int raw = 0;
+    if (waitpid(pid, &raw, WNOHANG) == pid) {
+      status = decodeStatus(raw);
+      exited = true;  // one more pass drains what is left
+    } else if (std::chrono::steady_clock::now() > deadline) {
+      kill(pid, SIGKILL);
+      waitpid(pid, nullptr, 0);
+      break;
+    }
+  }
+  close(master);
+  EXPECT_EQ(status, 0) << err;
+  EXPECT_TRUE(contains(err, "\rglint: [")) << err;
+  EXPECT_TRUE(contains(err, "100%")) << err;
+  EXPECT_FALSE(std::regex_search(err, std::regex("glint: [0-9]+% \\(elapsed"))) << "no log lines";
+  EXPECT_TRUE(contains(err, "ETA")) << err;
+  EXPECT_TRUE(contains(err, "Mrays/s")) << err;
+}
+
+}  // namespace
