@@ -85,8 +85,15 @@ struct Aggregate::BuildItem {
   std::uint32_t index = 0;  // into primitives_
 };
 
-Aggregate::Aggregate(std::vector<Primitive> primitives, std::vector<Color> primitiveTransmission)
-    : primitives_(std::move(primitives)), transmission_(std::move(primitiveTransmission)) {
+Aggregate::Aggregate(std::vector<Primitive> primitives, std::vector<Color> primitiveTransmission,
+                     std::vector<TriangleMesh> meshes, std::vector<Color> meshTransmission,
+                     Acceleration acceleration)
+    : primitives_(std::move(primitives)),
+      meshes_(std::move(meshes)),
+      transmission_(std::move(primitiveTransmission)) {
+  // Meshes and brute force arrive with the acceleration work; until then they are refused loudly.
+  if (!meshes_.empty() || !meshTransmission.empty() || acceleration != Acceleration::Bvh)
+    throw std::logic_error("Aggregate: triangle meshes and brute force are not implemented yet");
   if (transmission_.size() != primitives_.size()) {
     throw std::invalid_argument("Aggregate: " + std::to_string(transmission_.size()) +
                                 " transmission colors for " + std::to_string(primitives_.size()) +
@@ -280,6 +287,8 @@ bool Aggregate::intersect(const Ray& ray, double tMin, double tMax, Hit& hit) co
   if (found) {
     hit.t = closest;
     hit.normal = hitNormal;
+    hit.shadingNormal = hitNormal;
+    hit.mesh = kNoMesh;
     hit.primitive = hitPrimitive;
   }
   return found;

@@ -9,20 +9,33 @@
 #include "glint/core/color.h"
 #include "glint/core/ray.h"
 #include "glint/geometry/shape.h"
+#include "glint/geometry/triangle_mesh.h"
 
 namespace glint {
+
+inline constexpr std::uint32_t kNoMesh = 0xffffffffu;
 
 struct Hit {
   double t = 0;                 // ray parameter
   Normal3 normal;               // unit geometric world-space normal, as the shape defines it
-  std::uint32_t primitive = 0;  // index into the primitives passed to the Aggregate
+  Normal3 shadingNormal;        // unit; interpolated vertex normal on smooth meshes, else = normal
+  std::uint32_t primitive = 0;  // index into the primitives, when mesh == kNoMesh
+  std::uint32_t mesh = kNoMesh; // index into the meshes, or kNoMesh for an analytic primitive
+  std::uint32_t triangle = 0;   // triangle index within the mesh
 };
+
+// How the Aggregate organises its primitives: a BVH, or none (every ray tests every primitive —
+// only for measuring what the BVH buys).
+enum class Acceleration { Bvh, BruteForce };
 
 class Aggregate {
  public:
   // primitiveTransmission[i] is the factor a shadow ray keeps each time it crosses primitive i
   // (the material's kt); same size as primitives.
-  Aggregate(std::vector<Primitive> primitives, std::vector<Color> primitiveTransmission);
+  // meshTransmission[m] likewise for every triangle of meshes[m].
+  Aggregate(std::vector<Primitive> primitives, std::vector<Color> primitiveTransmission,
+            std::vector<TriangleMesh> meshes = {}, std::vector<Color> meshTransmission = {},
+            Acceleration acceleration = Acceleration::Bvh);
 
   // Closest hit with tMin < t < tMax.
   bool intersect(const Ray& ray, double tMin, double tMax, Hit& hit) const;
@@ -30,6 +43,7 @@ class Aggregate {
   Color transmittance(const Ray& ray, double tMin, double tMax) const;
 
   const std::vector<Primitive>& primitives() const { return primitives_; }
+  const std::vector<TriangleMesh>& meshes() const { return meshes_; }
   Bounds3 bounds() const { return bounds_; }  // of the bounded primitives
 
  private:
@@ -45,6 +59,7 @@ class Aggregate {
   friend struct AggregateInspector;  // aggregate_test.cpp checks the node layout invariants
 
   std::vector<Primitive> primitives_;
+  std::vector<TriangleMesh> meshes_;
   std::vector<Color> transmission_;
   std::vector<std::uint32_t> order_;      // bounded primitive indices in leaf order
   std::vector<std::uint32_t> unbounded_;  // primitives tested on every ray

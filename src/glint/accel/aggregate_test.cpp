@@ -95,7 +95,11 @@ bool bruteIntersect(const std::vector<Primitive>& prims, const Ray& ray, double 
   for (std::uint32_t i = 0; i < prims.size(); ++i) {
     ShapeHit h;
     if (prims[i].intersect(ray, tMin, tMax, h) && (!found || h.t < hit.t)) {
-      hit = {h.t, h.normal, i};
+      hit = Hit{};
+      hit.t = h.t;
+      hit.normal = h.normal;
+      hit.shadingNormal = h.normal;
+      hit.primitive = i;
       found = true;
     }
   }

@@ -179,6 +179,9 @@ LoadedScene load(const std::string& file, bool showWarnings) {
   } catch (const SceneError& error) {
     if (error.diagnostics().empty()) throw CliError(kExitBadInput, error.what());
     printDiagnostics(error.diagnostics());
+    if (error.unreported() > 0)
+      emit(stderr, fmt::format("{}: {} more error{} not shown\n", file, error.unreported(),
+                               error.unreported() == 1 ? "" : "s"));
     throw CliError(kExitBadInput, "");
   }
 }

@@ -42,7 +42,10 @@ std::string describeAll(const std::vector<Diagnostic>& diagnostics) {
 
 SceneError::SceneError(std::vector<Diagnostic> diagnostics)
     : std::runtime_error(describeAll(diagnostics)), diagnostics_(std::move(diagnostics)) {
-  if (diagnostics_.size() > kMaxReportedErrors) diagnostics_.resize(kMaxReportedErrors);
+  if (diagnostics_.size() > kMaxReportedErrors) {
+    unreported_ = diagnostics_.size() - kMaxReportedErrors;
+    diagnostics_.resize(kMaxReportedErrors);
+  }
 }
 
 }  // namespace glint

@@ -31,9 +31,12 @@ class SceneError : public std::runtime_error {
   static constexpr std::size_t kMaxReportedErrors = 20;
   explicit SceneError(std::vector<Diagnostic> diagnostics);
   const std::vector<Diagnostic>& diagnostics() const { return diagnostics_; }
+  // Errors found beyond the kMaxReportedErrors kept in diagnostics().
+  std::size_t unreported() const { return unreported_; }
 
  private:
   std::vector<Diagnostic> diagnostics_;
+  std::size_t unreported_ = 0;
 };
 
 }  // namespace glint

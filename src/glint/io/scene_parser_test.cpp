@@ -423,6 +423,7 @@ TEST(SceneParser, AtMostTwentyErrorsReported) {
     for (std::size_t i = 0; i < e.diagnostics().size(); ++i) {
       EXPECT_EQ(e.diagnostics()[i].where.line, static_cast<int>(4 + i));
     }
+    EXPECT_EQ(e.unreported(), 5u);
     EXPECT_THAT(std::string(e.what()), HasSubstr("5 more errors not shown"));
     EXPECT_THAT(std::string(e.what()), HasSubstr("t.yaml:4:47: sphere.radius must be > 0, got -1"));
   }

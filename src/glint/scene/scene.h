@@ -45,6 +45,8 @@ struct RenderSettings {
 struct SceneParts {
   std::string name;
   std::vector<Primitive> primitives;
+  std::vector<TriangleMesh> meshes;             // mesh material indices point into `materials`
+  Acceleration acceleration = Acceleration::Bvh;
   std::vector<Material> materials{Material{}};  // index 0: the default material
   std::vector<Light> lights;
   Color ambient;      // Ia = ambient color × ambient intensity
