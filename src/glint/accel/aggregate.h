@@ -1,27 +1,30 @@
-// The frozen collection of primitives with its two queries: closest hit, and shadow transmittance.
-// Bounded primitives go into a bounding volume hierarchy (binned SAH build, flattened nodes,
-// near-child-first traversal); unbounded ones (planes, tubes) are tested on every ray.
+// The frozen collection of primitives and mesh triangles with its two queries: closest hit, and
+// shadow transmittance. Bounded primitives and all mesh triangles go into one 4-wide bounding
+// volume hierarchy (bvh4.h: binned SAH build, flat node array, near-child-first traversal with SSE
+// slab tests); unbounded primitives (planes, tubes) are tested on every ray.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "glint/accel/bvh4.h"
 #include "glint/core/color.h"
 #include "glint/core/ray.h"
 #include "glint/geometry/shape.h"
 #include "glint/geometry/triangle_mesh.h"
+#include "glint/geometry/watertight_triangle.h"
 
 namespace glint {
 
 inline constexpr std::uint32_t kNoMesh = 0xffffffffu;
 
 struct Hit {
-  double t = 0;                 // ray parameter
-  Normal3 normal;               // unit geometric world-space normal, as the shape defines it
-  Normal3 shadingNormal;        // unit; interpolated vertex normal on smooth meshes, else = normal
-  std::uint32_t primitive = 0;  // index into the primitives, when mesh == kNoMesh
-  std::uint32_t mesh = kNoMesh; // index into the meshes, or kNoMesh for an analytic primitive
-  std::uint32_t triangle = 0;   // triangle index within the mesh
+  double t = 0;                  // ray parameter
+  Normal3 normal;                // unit geometric world-space normal, as the shape defines it
+  Normal3 shadingNormal;         // unit; interpolated vertex normal on smooth meshes, else = normal
+  std::uint32_t primitive = 0;   // index into the primitives, when mesh == kNoMesh
+  std::uint32_t mesh = kNoMesh;  // index into the meshes, or kNoMesh for an analytic primitive
+  std::uint32_t triangle = 0;    // triangle index within the mesh
 };
 
 // How the Aggregate organises its primitives: a BVH, or none (every ray tests every primitive —
@@ -32,39 +35,58 @@ class Aggregate {
  public:
   // primitiveTransmission[i] is the factor a shadow ray keeps each time it crosses primitive i
   // (the material's kt); same size as primitives.
-  // meshTransmission[m] likewise for every triangle of meshes[m].
+  // meshTransmission[m] likewise for every triangle of meshes[m]; same size as meshes.
+  // Throws std::invalid_argument for mismatched sizes, a mesh whose index count is not a multiple
+  // of 3, an index past the mesh's positions, or normals that are neither absent nor one per
+  // position; std::length_error past 2^32 − 1 references or kMaxMeshes meshes.
+  // Degenerate triangles (zero area or non-finite vertices) are left out: they never hit.
+  // Large inputs are built in parallel on the calling oneTBB arena; the result does not depend on
+  // the thread count.
   Aggregate(std::vector<Primitive> primitives, std::vector<Color> primitiveTransmission,
             std::vector<TriangleMesh> meshes = {}, std::vector<Color> meshTransmission = {},
             Acceleration acceleration = Acceleration::Bvh);
 
-  // Closest hit with tMin < t < tMax.
+  // Closest hit with tMin < t < tMax. The slab tests run in single precision on boxes rounded
+  // outward; rays must have finite origins within ±1e38 and no direction component above 1e30 in
+  // magnitude (every ray a scene produces).
   bool intersect(const Ray& ray, double tMin, double tMax, Hit& hit) const;
   // Product of kt over every surface crossing in (tMin, tMax); stops early once it is black.
   Color transmittance(const Ray& ray, double tMin, double tMax) const;
 
   const std::vector<Primitive>& primitives() const { return primitives_; }
   const std::vector<TriangleMesh>& meshes() const { return meshes_; }
-  Bounds3 bounds() const { return bounds_; }  // of the bounded primitives
+  Bounds3 bounds() const { return bounds_; }  // of the bounded primitives and the mesh triangles
+  Acceleration acceleration() const { return acceleration_; }
+  // Mesh triangles in the structure (the degenerate ones left out).
+  std::size_t triangleCount() const { return triangleCount_; }
+  // Heap bytes held for meshes (positions, normals, indices), the tree and its leaf references;
+  // primitives count with sizeof(Primitive) each. For "bytes per triangle" figures.
+  std::size_t memoryBytes() const;
 
  private:
-  struct Node {
-    Bounds3 bounds;
-    std::uint32_t offset = 0;  // leaf: first index into order_; inner: index of the second child
-    std::uint16_t count = 0;   // leaf: number of primitives; 0 for inner nodes
-    std::uint8_t axis = 0;     // inner: split axis (the first child is on the low side)
-  };
-  struct BuildItem;  // one bounded primitive during the build (aggregate.cpp)
-  // Appends the subtree over items[begin, end) to nodes_ depth-first (binned SAH, median fallback).
-  void build(std::vector<BuildItem>& items, std::uint32_t begin, std::uint32_t end, int depth);
+  bool intersectBruteForce(const Ray& ray, double tMin, double tMax, Hit& hit) const;
+  Color transmittanceBruteForce(const Ray& ray, double tMin, double tMax) const;
+  void finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle, const WatertightHit& candidate,
+                         Hit& hit) const;
   friend struct AggregateInspector;  // aggregate_test.cpp checks the node layout invariants
 
   std::vector<Primitive> primitives_;
+  std::vector<Color> transmission_;  // per primitive
   std::vector<TriangleMesh> meshes_;
-  std::vector<Color> transmission_;
-  std::vector<std::uint32_t> order_;      // bounded primitive indices in leaf order
-  std::vector<std::uint32_t> unbounded_;  // primitives tested on every ray
-  std::vector<Node> nodes_;               // depth-first; the first child follows its parent
+  std::vector<Color> meshTransmission_;
+  std::vector<std::uint32_t> unbounded_;  // primitives tested on every ray (Bvh only)
+  // Bvh: the 4-wide tree; leaves point into leafRefs_, which holds primitive indices or triangle
+  // indices within the leaf's mesh, in leaf order.
+  std::vector<bvh::Node> nodes_;
+  std::vector<std::uint32_t> leafRefs_;
+  std::uint32_t rootChild_ = 0;
+  std::uint32_t rootInfo_ = bvh::kEmpty;
+  // BruteForce: the non-degenerate triangles of mesh m are leafRefs_[meshBegin_[m] ..
+  // meshBegin_[m + 1]).
+  std::vector<std::uint32_t> meshBegin_;
+  std::size_t triangleCount_ = 0;
   Bounds3 bounds_;
+  Acceleration acceleration_ = Acceleration::Bvh;
 };
 
 }  // namespace glint

@@ -1,8 +1,10 @@
-// The closed set of analytic shapes (the seed's Geometry family and DESIGN.md §5), dispatched through
-// std::variant: no virtual call and no allocation per ray.
+// The closed set of analytic shapes (the seed's Geometry family and DESIGN.md §5), dispatched
+// through std::variant: no virtual call and no allocation per ray.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <variant>
@@ -30,14 +32,18 @@ struct ShapeHit {
 };
 
 // Conventions shared by every shape below:
-// - intersect(ray, tMin, tMax, hit): closest hit with tMin < t < tMax (both bounds exclusive), for any
-//   non-zero ray direction. A ray that starts exactly on the surface and leaves it does not hit it at
-//   t = 0; a tangent ray (touching at a single point) misses; a ray parallel to a flat shape misses.
-// - crossings(ray, tMin, tMax): how many times the ray crosses the surface in (tMin, tMax) — used for
+// - intersect(ray, tMin, tMax, hit): closest hit with tMin < t < tMax (both bounds exclusive), for
+// any
+//   non-zero ray direction. A ray that starts exactly on the surface and leaves it does not hit it
+//   at t = 0; a tangent ray (touching at a single point) misses; a ray parallel to a flat shape
+//   misses.
+// - crossings(ray, tMin, tMax): how many times the ray crosses the surface in (tMin, tMax) — used
+// for
 //   shadow transmittance, where a transparent sphere in the way counts twice.
 // - bounds(): world-space box; unbounded shapes (plane, tube) return Bounds3::unbounded().
 // - normalAt(p): unit geometric normal at a point p on the surface (the seed's getNormal).
-// - Closed shapes (sphere, tube, cylinder, box) have outward normals; flat shapes have the normal of
+// - Closed shapes (sphere, tube, cylinder, box) have outward normals; flat shapes have the normal
+// of
 //   their definition (plane, disk: as given; triangle, polygon, quadrangle: (v1−v0)×(v2−v0) by the
 //   right-hand rule over the vertex order; rectangle: edge0 × edge1).
 // - Each shape has a static make(...) factory that validates its parameters and throws ShapeError.
@@ -101,9 +107,11 @@ struct Rectangle {
 };
 
 // Planar quadrangle v0 v1 v2 v3 (in order, simple, need not be convex), split into two triangles
-// along a diagonal that lies inside it.
+// along a diagonal that lies inside it. Stored compactly: the four vertices rotated so that the
+// inner diagonal runs from corners[0] to corners[2]; the halves are (0, 1, 2) and (0, 2, 3), each
+// intersected with the watertight triangle test.
 struct Quadrangle {
-  Triangle first, second;
+  std::array<Point3, 4> corners;
   Normal3 normal;  // unit, by the right-hand rule over the vertex order
   static Quadrangle make(const Point3& v0, const Point3& v1, const Point3& v2, const Point3& v3);
   bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
@@ -180,12 +188,14 @@ class Primitive {
   const Color& emission() const { return emission_; }
 
  private:
+  // What a ray query reads comes first. The transform lives out of line, shared between copies:
+  // most primitives have none, and two inline 4×4 matrix pairs made a Primitive ~800 bytes.
+  // Its inverse matrix is objectFromWorld, which maps rays; normals map by its transpose.
   Shape shape_;
-  std::optional<Transform> worldFromObject_;  // absent: the shape is already in world space
-  Transform objectFromWorld_;                 // inverse of worldFromObject_, used once per ray
-  std::uint32_t materialIndex_ = 0;
-  Color emission_;
+  std::shared_ptr<const Transform> worldFromObject_;  // null: the shape is already in world space
   Bounds3 bounds_;
+  Color emission_;
+  std::uint32_t materialIndex_ = 0;
 };
 
 }  // namespace glint

@@ -10,28 +10,23 @@
 #include <utility>
 
 #include "glint/geometry/shape.h"
+#include "glint/geometry/watertight_triangle.h"
 
 namespace glint {
 
 namespace {
 
-constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
-
-// Rounding bound for "the ray direction lies in the plane of a flat shape" (and "the direction is
-// along a tube's axis"). n·d is a three-term dot product (error ≤ γ3·Σ|n_i d_i|) of a unit normal
-// that is itself a few ulps off; 8ε covers both. Below it the sign of n·d is noise, and a ray lying
-// in the plane would otherwise get a hit at an arbitrary t. Only rays within ~1e-15 rad of the
-// plane are affected, whose genuine hits would lie ~1e15 plane distances away.
-constexpr double kParallelBound = 8 * kEpsilon;
+// kParallelBound (watertight_triangle.h) also bounds "the direction is along a tube's axis".
 
 // Tolerances for degenerate input, relative to the shape's size (DESIGN.md §7):
-// - collinear: |(b−a)×(c−a)| (twice the area) ≤ kCollinearTolerance · size², i.e. the shape is
-//   thinner than 1e-12 of its size — far below anything a scene can mean, above double rounding;
+// - collinear: |(b−a)×(c−a)| (twice the area) ≤ kCollinearTolerance (watertight_triangle.h) ·
+// size²,
+//   i.e. the shape is thinner than 1e-12 of its size — far below anything a scene can mean, above
+//   double rounding;
 // - planar / perpendicular / convex: a vertex may stray from the plane by kShapeTolerance · size,
 //   two rectangle edges may have cosine up to kShapeTolerance, a convex corner may turn the wrong
 //   way by a sine of kShapeTolerance — loose enough for coordinates written with ~10 significant
 //   digits.
-constexpr double kCollinearTolerance = 1e-12;
 constexpr double kShapeTolerance = 1e-9;
 
 // --- formatting and validation of make() parameters ---
@@ -129,8 +124,7 @@ Turn turnAt(const Point3* vertices, std::size_t count, std::size_t i, const Norm
 }
 
 bool isParallel(const Normal3& n, const Vec3& d, double nDotD) {
-  return std::abs(nDotD) <=
-         kParallelBound * (std::abs(n.x * d.x) + std::abs(n.y * d.y) + std::abs(n.z * d.z));
+  return isParallelToPlane(toVec(n), d, nDotD);
 }
 
 // Ray parameter where the ray meets the plane (point, unit normal), or false when the ray is
@@ -177,22 +171,6 @@ bool tubeRoots(const Vec3& f, const Vec3& d, const Vec3& axis, double r, double&
 
 Normal3 radialNormal(const Vec3& fromAxisPoint, const Vec3& axis) {
   return Normal3(normalize(fromAxisPoint - axis * dot(fromAxisPoint, axis)));
-}
-
-// The 2D edge function a·b − c·d of the watertight triangle test. Watertightness needs
-// edge(p, q) = −edge(q, p) in sign, exactly. Plain double arithmetic gives that (rounding is
-// symmetric), but when the target has FMA the compiler may fuse one of the two products (GCC
-// contracts by default in C++), breaking the symmetry. There Kahan's difference of products
-// (relative error ≤ 2u, Jeannerod, Louvet and Muller 2013) is used instead: it returns the sign of
-// the exact value, which is antisymmetric, and exactly 0 only when the exact value is 0.
-double edgeFunction(double a, double b, double c, double d) {
-#ifdef __FMA__
-  const double cd = c * d;
-  const double roundingOfCd = std::fma(-c, d, cd);
-  return std::fma(a, b, -cd) + roundingOfCd;
-#else
-  return a * b - c * d;
-#endif
 }
 
 // Exact bounds of a disk (centre c, unit normal n, radius r): along axis i it extends
@@ -302,53 +280,15 @@ Triangle Triangle::make(const Point3& v0, const Point3& v1, const Point3& v2) {
   return Triangle{v0, v1, v2, Normal3(normalize(n))};
 }
 
-// Watertight ray–triangle intersection (Woop, Benthin and Wald, JCGT 2013), in double. The
-// vertices are translated to the ray origin, permuted so the dominant direction axis becomes z
-// (swapping x and y when it is negative to keep the winding), and sheared so the ray is +z. The
-// three 2D edge functions then depend only on the two vertices of their edge, so a shared edge gets
-// exactly the opposite (or same) value in both triangles and a ray through it hits at least one of
-// them. Edge functions that round to exactly zero are recomputed in long double, as the paper does
-// in double for its single-precision test; a hit on an edge or vertex counts.
+// The watertight test of watertight_triangle.h (Woop, Benthin and Wald 2013): rays through a shared
+// edge or vertex hit one of the triangles sharing it.
 bool Triangle::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
-  const Vec3& d = ray.direction;
-  if (isParallel(normal, d, dot(normal, d))) return false;
-
-  const Vec3 absD = abs(d);
-  const int kz = (absD.x > absD.y) ? (absD.x > absD.z ? 0 : 2) : (absD.y > absD.z ? 1 : 2);
-  int kx = (kz + 1) % 3;
-  int ky = (kx + 1) % 3;
-  if (d[kz] < 0) std::swap(kx, ky);
-  const double sx = d[kx] / d[kz];
-  const double sy = d[ky] / d[kz];
-  const double sz = 1.0 / d[kz];
-
-  const Vec3 a = v0 - ray.origin;
-  const Vec3 b = v1 - ray.origin;
-  const Vec3 c = v2 - ray.origin;
-  const double ax = a[kx] - sx * a[kz];
-  const double ay = a[ky] - sy * a[kz];
-  const double bx = b[kx] - sx * b[kz];
-  const double by = b[ky] - sy * b[kz];
-  const double cx = c[kx] - sx * c[kz];
-  const double cy = c[ky] - sy * c[kz];
-
-  double u = edgeFunction(cx, by, cy, bx);
-  double v = edgeFunction(ax, cy, ay, cx);
-  double w = edgeFunction(bx, ay, by, ax);
-  if (u == 0 || v == 0 || w == 0) {
-    using Wide = long double;
-    u = static_cast<double>(Wide{cx} * Wide{by} - Wide{cy} * Wide{bx});
-    v = static_cast<double>(Wide{ax} * Wide{cy} - Wide{ay} * Wide{cx});
-    w = static_cast<double>(Wide{bx} * Wide{ay} - Wide{by} * Wide{ax});
+  WatertightHit candidate;
+  if (!intersectWatertight(WatertightRay(ray), v0, v1, v2, tMin, tMax, candidate) ||
+      isParallel(normal, ray.direction, dot(normal, ray.direction))) {
+    return false;
   }
-  if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return false;
-  const double det = u + v + w;
-  if (det == 0) return false;
-
-  const double scaledT = u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz]);
-  const double t = scaledT / det;
-  if (!inOpenRange(t, tMin, tMax)) return false;
-  hit.t = t;
+  hit.t = candidate.t;
   hit.normal = normal;
   return true;
 }
@@ -486,22 +426,34 @@ Quadrangle Quadrangle::make(const Point3& v0, const Point3& v1, const Point3& v2
   // The diagonal from the reflex corner (or, when convex, from the flattest one, which may be a
   // straight 180° corner) lies inside and leaves no degenerate half.
   const std::size_t k = diagonalFrom;
+  const std::array<Point3, 4> corners{v[k], v[(k + 1) % 4], v[(k + 2) % 4], v[(k + 3) % 4]};
   try {
-    return Quadrangle{Triangle::make(v[k], v[(k + 1) % 4], v[(k + 2) % 4]),
-                      Triangle::make(v[k], v[(k + 2) % 4], v[(k + 3) % 4]), n};
+    Triangle::make(corners[0], corners[1], corners[2]);
+    Triangle::make(corners[0], corners[2], corners[3]);
   } catch (const ShapeError&) {
     throw ShapeError(fmt::format("vertices are degenerate: {}, {}, {}, {}", format(v0), format(v1),
                                  format(v2), format(v3)));
   }
+  return Quadrangle{corners, n};
 }
 
 bool Quadrangle::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
   // The halves are coplanar (within the planarity tolerance), so the nearer one is kept only to be
-  // exact; the normal is the quadrangle's, identical for both halves.
-  bool found = first.intersect(ray, tMin, tMax, hit);
-  if (second.intersect(ray, tMin, found ? hit.t : tMax, hit)) found = true;
-  if (found) hit.normal = normal;
-  return found;
+  // exact; the normal is the quadrangle's, identical for both halves. Each half rejects rays in
+  // its own plane, as a Triangle does.
+  const WatertightRay watertightRay(ray);
+  const auto half = [&](const Point3& a, const Point3& b, const Point3& c, double tFar,
+                        WatertightHit& candidate) {
+    return intersectWatertight(watertightRay, a, b, c, tMin, tFar, candidate) &&
+           !isParallelToPlane(cross(b - a, c - a), ray.direction);
+  };
+  WatertightHit candidate;
+  bool found = half(corners[0], corners[1], corners[2], tMax, candidate);
+  if (half(corners[0], corners[2], corners[3], found ? candidate.t : tMax, candidate)) found = true;
+  if (!found) return false;
+  hit.t = candidate.t;
+  hit.normal = normal;
+  return true;
 }
 
 int Quadrangle::crossings(const Ray& ray, double tMin, double tMax) const {
@@ -509,7 +461,9 @@ int Quadrangle::crossings(const Ray& ray, double tMin, double tMax) const {
   return intersect(ray, tMin, tMax, hit) ? 1 : 0;
 }
 
-Bounds3 Quadrangle::bounds() const { return unite(first.bounds(), second.bounds()); }
+Bounds3 Quadrangle::bounds() const {
+  return unite(Bounds3(corners[0], corners[1]), Bounds3(corners[2], corners[3]));
+}
 
 Normal3 Quadrangle::normalAt(const Point3&) const { return normal; }
 
@@ -818,15 +772,31 @@ void requireInvertibleAffine(const Transform& transform) {
     throw ShapeError(fmt::format("transform must be invertible, got determinant {}", det));
 }
 
+// objectFromWorld applied to a ray: the inverse matrix of worldFromObject, with the same arithmetic
+// as Transform::operator() so results do not depend on where the matrix is stored.
+Ray objectRayOf(const Transform& worldFromObject, const Ray& r) {
+  const auto& m = worldFromObject.inverseMatrix().m;
+  const Point3& p = r.origin;
+  const Vec3& v = r.direction;
+  const double x = m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3];
+  const double y = m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3];
+  const double z = m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3];
+  const double w = m[3][0] * p.x + m[3][1] * p.y + m[3][2] * p.z + m[3][3];
+  const Point3 origin = w == 1 ? Point3{x, y, z} : Point3{x / w, y / w, z / w};
+  return Ray{
+      origin,
+      {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+       m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z}};
+}
+
 }  // namespace
 
 Primitive::Primitive(Shape shape, std::uint32_t materialIndex, const Color& emission,
                      std::optional<Transform> worldFromObject)
-    : shape_(std::move(shape)), materialIndex_(materialIndex), emission_(emission) {
+    : shape_(std::move(shape)), emission_(emission), materialIndex_(materialIndex) {
   if (worldFromObject && !worldFromObject->isIdentity()) {
     requireInvertibleAffine(*worldFromObject);
-    objectFromWorld_ = worldFromObject->inverse();
-    worldFromObject_ = std::move(worldFromObject);
+    worldFromObject_ = std::make_shared<const Transform>(*worldFromObject);
   }
   const Bounds3 objectBounds = std::visit([](const auto& s) { return s.bounds(); }, shape_);
   bounds_ = worldFromObject_ ? (*worldFromObject_)(objectBounds) : objectBounds;
@@ -836,7 +806,7 @@ bool Primitive::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hi
   if (!worldFromObject_)
     return std::visit([&](const auto& s) { return s.intersect(ray, tMin, tMax, hit); }, shape_);
   // The object-space direction is deliberately not normalised, so t is the same in both spaces.
-  const Ray objectRay = objectFromWorld_(ray);
+  const Ray objectRay = objectRayOf(*worldFromObject_, ray);
   if (!std::visit([&](const auto& s) { return s.intersect(objectRay, tMin, tMax, hit); }, shape_))
     return false;
   hit.normal = normalize((*worldFromObject_)(hit.normal));
@@ -844,7 +814,7 @@ bool Primitive::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hi
 }
 
 int Primitive::crossings(const Ray& ray, double tMin, double tMax) const {
-  const Ray objectRay = worldFromObject_ ? objectFromWorld_(ray) : ray;
+  const Ray objectRay = worldFromObject_ ? objectRayOf(*worldFromObject_, ray) : ray;
   return std::visit([&](const auto& s) { return s.crossings(objectRay, tMin, tMax); }, shape_);
 }
 

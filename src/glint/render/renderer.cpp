@@ -51,9 +51,12 @@ bool lightPosition(const Light& light, Point3& position) {
 }
 
 // Direct lighting (DESIGN.md §3), n the geometric normal, v the unit view direction:
-//   Σ_lights [(n·l)(n·v) > 0] · T_L(P) · I_L(P) · (kd·|n·l| + ks·max(0, −v·r)^shininess).
+//   Σ_lights [(n·l)(n·v) > 0] · T_L(P) · I_L(P) · (kd·|ns·l| + ks·max(0, −v·r)^shininess),
+// with the shading normal ns (= n except on smooth meshes) in the diffuse term and in r. The side
+// tests and the shadow ray's origin use the geometric n; a light on the other side of ns than of n
+// gives no diffuse term.
 Color directLight(const TraceContext& ctx, const Material& material, const Point3& p,
-                  const Normal3& n, const Vec3& v) {
+                  const Normal3& n, const Normal3& ns, const Vec3& v) {
   Color sum;
   // Nothing for a light to act on: skip the shadow rays too.
   const bool hasSpecular = !isBlack(material.ks);
@@ -75,9 +78,10 @@ Color directLight(const TraceContext& ctx, const Material& material, const Point
     const Color transmittance = ctx.scene.transmittance(shadowRay, tMax);
     if (isBlack(transmittance)) continue;
 
-    Color response = material.kd * std::abs(nl);
+    const double nsl = dot(ns, l);
+    Color response = nsl * nl > 0 ? material.kd * std::abs(nsl) : Color();
     if (hasSpecular) {
-      const Vec3 r = l - toVec(n) * (2 * nl);  // the light's mirror direction about n
+      const Vec3 r = l - toVec(ns) * (2 * nsl);  // the light's mirror direction about ns
       response += material.ks * std::pow(std::max(0.0, -dot(v, r)), material.shininess);
     }
     sum += transmittance * sample.intensity * response;
@@ -143,18 +147,25 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   if (!ctx.scene.intersect(ray, kInfinity, hit)) return ctx.scene.background();
   const int hitDepth = depth + 1;
 
-  const Primitive& primitive = ctx.scene.primitives()[hit.primitive];
-  const Material& material = ctx.scene.materialOf(hit.primitive);
+  const Material& material = ctx.scene.materialOf(hit);
   const Point3 p = ray.at(hit.t);
-  const Normal3& n = hit.normal;
+  const Normal3& n = hit.normal;  // geometric: side decisions and ray origins
   const Vec3& v = ray.direction;  // unit for every ray the renderer creates
   const double nv = dot(n, v);
+  // Shading normal: directions and the diffuse/specular terms. One facing the other way from the
+  // geometric normal as seen along v would shade a back face; the geometric one is used then.
+  const Normal3& ns = dot(hit.shadingNormal, v) * nv > 0 ? hit.shadingNormal : n;
+  const double nsv = dot(ns, v);
 
-  Color color = primitive.emission() + material.ka * ctx.scene.ambient();
-  color += directLight(ctx, material, p, n, v);
+  Color color = ctx.scene.emissionOf(hit) + material.ka * ctx.scene.ambient();
+  color += directLight(ctx, material, p, n, ns, v);
   if (hitDepth >= ctx.maxDepth) return color;
 
-  const Vec3 reflected = v - toVec(n) * (2 * nv);
+  // A mirror direction about ns that would dive below the geometric surface is replaced by the
+  // geometric mirror direction (it can only happen where ns ≠ n).
+  const bool smooth = !(ns == n);
+  Vec3 reflected = v - toVec(ns) * (2 * nsv);
+  if (smooth && !(dot(n, reflected) * nv < 0)) reflected = v - toVec(n) * (2 * nv);
   Color branchWeight;
   if (worthTracing(material.kr, weight, ctx.minWeight, branchWeight)) {
     color += material.kr * traceLobe(ctx, p, n, reflected, material.reflectionBlur,
@@ -166,7 +177,7 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
       // Snell's law with the relative index; n·v < 0 means the ray enters the surface.
       const bool entering = nv < 0;
       const double eta = entering ? 1 / material.ior : material.ior;
-      const Vec3 facing = entering ? toVec(n) : -toVec(n);  // normal on the incident side
+      const Vec3 facing = entering ? toVec(ns) : -toVec(ns);  // normal on the incident side
       const double cosIncident = -dot(facing, v);
       const double sin2Transmitted = eta * eta * std::max(0.0, 1 - cosIncident * cosIncident);
       if (sin2Transmitted >= 1) {
@@ -174,6 +185,8 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
       } else {
         const double cosTransmitted = std::sqrt(1 - sin2Transmitted);
         transmitted = v * eta + facing * (eta * cosIncident - cosTransmitted);
+        // Bent about ns, it must still cross the geometric surface; otherwise go straight on.
+        if (smooth && !(dot(n, transmitted) * nv > 0)) transmitted = v;
       }
     }
     color += material.kt * traceLobe(ctx, p, n, transmitted, material.refractionBlur,

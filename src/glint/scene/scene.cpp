@@ -16,22 +16,29 @@ CameraSpec cameraSpecFor(const SceneParts& parts) {
   return spec;
 }
 
-// Checks every material index and pairs each primitive with its material's kt, the factor a shadow
-// ray keeps per crossing.
-Aggregate buildAggregate(std::vector<Primitive> primitives,
-                         const std::vector<Material>& materials) {
-  std::vector<Color> transmission;
-  transmission.reserve(primitives.size());
-  for (std::size_t i = 0; i < primitives.size(); ++i) {
-    const std::uint32_t material = primitives[i].materialIndex();
+// Checks every material index and pairs each primitive and mesh with its material's kt, the factor
+// a shadow ray keeps per crossing.
+Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materials) {
+  const auto checkMaterial = [&](const char* what, std::size_t i, std::uint32_t material) {
     if (material >= materials.size()) {
-      throw std::invalid_argument("primitive " + std::to_string(i) + " uses material " +
+      throw std::invalid_argument(std::string(what) + " " + std::to_string(i) + " uses material " +
                                   std::to_string(material) + ", but the scene has only " +
                                   std::to_string(materials.size()) + " materials");
     }
-    transmission.push_back(materials[material].kt);
+    return materials[material].kt;
+  };
+  std::vector<Color> transmission;
+  transmission.reserve(parts.primitives.size());
+  for (std::size_t i = 0; i < parts.primitives.size(); ++i) {
+    transmission.push_back(checkMaterial("primitive", i, parts.primitives[i].materialIndex()));
   }
-  return Aggregate(std::move(primitives), std::move(transmission));
+  std::vector<Color> meshTransmission;
+  meshTransmission.reserve(parts.meshes.size());
+  for (std::size_t m = 0; m < parts.meshes.size(); ++m) {
+    meshTransmission.push_back(checkMaterial("mesh", m, parts.meshes[m].materialIndex));
+  }
+  return Aggregate(std::move(parts.primitives), std::move(transmission), std::move(parts.meshes),
+                   std::move(meshTransmission), parts.acceleration);
 }
 
 }  // namespace
@@ -45,6 +52,6 @@ Scene::Scene(SceneParts parts)
       camera_(cameraSpecFor(parts)),
       image_(std::move(parts.image)),
       render_(parts.render),
-      aggregate_(buildAggregate(std::move(parts.primitives), materials_)) {}
+      aggregate_(buildAggregate(parts, materials_)) {}
 
 }  // namespace glint

@@ -1,6 +1,6 @@
 // The frozen scene: primitives in their acceleration structure, materials, lights, camera and the
-// image and render settings. Built once (by code or by io/scene_builder), then only queried (const),
-// shared by all render threads without locks.
+// image and render settings. Built once (by code or by io/scene_builder), then only queried
+// (const), shared by all render threads without locks.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +26,7 @@ struct GridOverlay {
 };
 
 struct ImageSettings {
-  int width = 1;   // pixels (also given to the camera)
+  int width = 1;  // pixels (also given to the camera)
   int height = 1;
   int samples = 1;  // per pixel, stratified
   Encoding encoding = Encoding::Srgb;
@@ -45,7 +45,7 @@ struct RenderSettings {
 struct SceneParts {
   std::string name;
   std::vector<Primitive> primitives;
-  std::vector<TriangleMesh> meshes;             // mesh material indices point into `materials`
+  std::vector<TriangleMesh> meshes;  // mesh material indices point into `materials`
   Acceleration acceleration = Acceleration::Bvh;
   std::vector<Material> materials{Material{}};  // index 0: the default material
   std::vector<Light> lights;
@@ -59,15 +59,26 @@ struct SceneParts {
 class Scene {
  public:
   // Builds the camera and the acceleration structure. Throws CameraError / std::invalid_argument
-  // for an invalid camera or a primitive whose material index is out of range.
+  // for an invalid camera, a primitive or mesh whose material index is out of range, or a mesh
+  // with invalid indices (see Aggregate).
   explicit Scene(SceneParts parts);
 
   const std::string& name() const { return name_; }
   const Aggregate& aggregate() const { return aggregate_; }
   const std::vector<Primitive>& primitives() const { return aggregate_.primitives(); }
   const std::vector<Material>& materials() const { return materials_; }
+  const std::vector<TriangleMesh>& meshes() const { return aggregate_.meshes(); }
   const Material& materialOf(std::uint32_t primitive) const {
     return materials_[aggregate_.primitives()[primitive].materialIndex()];
+  }
+  // The material and the emission of what a ray hit: its primitive's, or its mesh's.
+  const Material& materialOf(const Hit& hit) const {
+    return materials_[hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].materialIndex()
+                                          : aggregate_.meshes()[hit.mesh].materialIndex];
+  }
+  const Color& emissionOf(const Hit& hit) const {
+    return hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].emission()
+                               : aggregate_.meshes()[hit.mesh].emission;
   }
   const std::vector<Light>& lights() const { return lights_; }
   const Color& ambient() const { return ambient_; }

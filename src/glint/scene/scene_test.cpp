@@ -99,5 +99,69 @@ TEST(SceneTest, InvalidCameraPropagates) {
   EXPECT_THROW(Scene{std::move(parts)}, CameraError);
 }
 
+// A unit square (two triangles) at z = −2 facing +z with material 2 and an emission, beside the
+// glass sphere scene.
+SceneParts meshParts() {
+  SceneParts parts = glassSphereParts();
+  Material red;
+  red.kd = Color(0.8, 0.1, 0.1);
+  parts.materials.push_back(red);
+  TriangleMesh square;
+  square.positions = {{3, -1, -2}, {5, -1, -2}, {5, 1, -2}, {3, 1, -2}};
+  square.indices = {0, 1, 2, 0, 2, 3};
+  square.materialIndex = 2;
+  square.emission = Color(0.25, 0.5, 1);
+  parts.meshes.push_back(square);
+  return parts;
+}
+
+TEST(SceneTest, MaterialAndEmissionOfMeshAndPrimitiveHits) {
+  const Scene scene(meshParts());
+  ASSERT_EQ(scene.meshes().size(), 1u);
+  Hit hit;
+  ASSERT_TRUE(scene.intersect({{4, 0.5, 5}, {0, 0, -1}}, kInfinity, hit));
+  EXPECT_EQ(hit.mesh, 0u);
+  EXPECT_NEAR(hit.t, 7, 1e-12);
+  EXPECT_EQ(&scene.materialOf(hit), &scene.materials()[2]);
+  EXPECT_EQ(scene.materialOf(hit).kd, Color(0.8, 0.1, 0.1));
+  EXPECT_EQ(scene.emissionOf(hit), Color(0.25, 0.5, 1));
+
+  ASSERT_TRUE(scene.intersect({{0, 0, 5}, {0, 0, -1}}, kInfinity, hit));
+  EXPECT_EQ(hit.mesh, kNoMesh);
+  EXPECT_EQ(hit.primitive, 0u);
+  EXPECT_EQ(scene.materialOf(hit).kt, Color(0.6));
+  EXPECT_EQ(scene.emissionOf(hit), Color());
+  ASSERT_TRUE(scene.intersect({{0, 0, -5}, {0, -1, 0}}, kInfinity, hit));
+  EXPECT_EQ(hit.primitive, 1u);
+  EXPECT_EQ(scene.emissionOf(hit), Color(0.1, 0.2, 0.3));
+  // The mesh's material is opaque: a shadow ray through the square is blocked.
+  EXPECT_EQ(scene.transmittance({{4, 0, -5}, {0, 0, 1}}, kInfinity), Color(0));
+  EXPECT_EQ(scene.transmittance({{4, 0, -5}, {0, 0, 1}}, 2.5), Color(1));
+}
+
+TEST(SceneTest, MeshTransmissionComesFromItsMaterial) {
+  SceneParts parts = meshParts();
+  parts.materials[2].kt = Color(0.5, 0.25, 1);
+  parts.acceleration = Acceleration::BruteForce;
+  const Scene scene(std::move(parts));
+  EXPECT_EQ(scene.aggregate().acceleration(), Acceleration::BruteForce);
+  // Off the shared diagonal (a ray through it may cross both triangles).
+  EXPECT_EQ(scene.transmittance({{4.5, -0.2, -5}, {0, 0, 1}}, kInfinity), Color(0.5, 0.25, 1));
+}
+
+TEST(SceneTest, BadMeshesThrow) {
+  SceneParts parts = meshParts();
+  parts.meshes[0].materialIndex = 3;
+  try {
+    const Scene scene(std::move(parts));
+    ADD_FAILURE() << "a mesh material index past the materials was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "mesh 0 uses material 3, but the scene has only 3 materials");
+  }
+  parts = meshParts();
+  parts.meshes[0].indices[4] = 4;
+  EXPECT_THROW(Scene{std::move(parts)}, std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace glint

@@ -1,0 +1,150 @@
+// The one ray–triangle kernel: the watertight test of Woop, Benthin and Wald (JCGT 2013), shared by
+// the analytic Triangle/Quadrangle shapes and the mesh triangles of the acceleration structure.
+#pragma once
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <type_traits>
+#include <utility>
+
+#include "glint/core/ray.h"
+#include "glint/core/vec.h"
+
+namespace glint {
+
+// Rounding bound for "the ray direction lies in the plane of a flat shape". n·d is a three-term dot
+// product (error ≤ γ3·Σ|n_i d_i|) of a normal that is itself a few ulps off; 8ε covers both. Below
+// it the sign of n·d is noise, and a ray lying in the plane would otherwise get a hit at an
+// arbitrary t. Only rays within ~1e-15 rad of the plane are affected, whose genuine hits would lie
+// ~1e15 plane distances away. The test is homogeneous in n, so n need not be unit.
+inline constexpr double kParallelBound = 8 * std::numeric_limits<double>::epsilon();
+
+inline bool isParallelToPlane(const Vec3& n, const Vec3& d, double nDotD) {
+  return std::abs(nDotD) <=
+         kParallelBound * (std::abs(n.x * d.x) + std::abs(n.y * d.y) + std::abs(n.z * d.z));
+}
+inline bool isParallelToPlane(const Vec3& n, const Vec3& d) {
+  return isParallelToPlane(n, d, dot(n, d));
+}
+
+// Degenerate when twice the area |e1×e2| ≤ 1e-12 · (longest edge)² (or a vertex is not finite): the
+// triangle is then thinner than 1e-12 of its longest edge. Triangle::make rejects such triangles;
+// the aggregate leaves such mesh triangles out, so they never hit.
+inline constexpr double kCollinearTolerance = 1e-12;
+
+inline bool isDegenerateTriangle(const Point3& p0, const Point3& p1, const Point3& p2) {
+  if (!isFinite(p0) || !isFinite(p1) || !isFinite(p2)) return true;
+  const double twiceArea = length(cross(p1 - p0, p2 - p0));
+  const double longest =
+      std::max({distanceSquared(p0, p1), distanceSquared(p1, p2), distanceSquared(p2, p0)});
+  return !(twiceArea > kCollinearTolerance * longest);
+}
+
+namespace watertight_detail {
+
+// The 2D edge function a·b − c·d. Watertightness needs edge(p, q) = −edge(q, p) in sign, exactly.
+// Plain double arithmetic gives that (rounding is symmetric), but when the target has FMA the
+// compiler may fuse one of the two products (GCC contracts by default in C++), breaking the
+// symmetry. There Kahan's difference of products (relative error ≤ 2u, Jeannerod, Louvet and
+// Muller 2013) is used instead: it returns the sign of the exact value, which is antisymmetric, and
+// exactly 0 only when the exact value is 0.
+inline double edgeFunction(double a, double b, double c, double d) {
+#ifdef __FMA__
+  const double cd = c * d;
+  const double roundingOfCd = std::fma(-c, d, cd);
+  return std::fma(a, b, -cd) + roundingOfCd;
+#else
+  return a * b - c * d;
+#endif
+}
+
+// Coordinate `axis` of a point (0 = x, 1 = y, 2 = z) read from its object representation: one load
+// with a computed offset, where Point3::operator[] would branch.
+inline double coordinate(const Point3& p, int axis) {
+  static_assert(std::is_standard_layout_v<Point3> && sizeof(Point3) == 3 * sizeof(double));
+  double value;
+  std::memcpy(&value, reinterpret_cast<const unsigned char*>(&p) + axis * sizeof(double),
+              sizeof value);
+  return value;
+}
+
+}  // namespace watertight_detail
+
+// What the per-triangle test shares for one ray: the axis permutation that makes the dominant
+// direction component z (x and y swapped when it is negative, to keep the winding) and the shear
+// that turns the ray into +z.
+struct WatertightRay {
+  Point3 origin;
+  int kx = 0, ky = 1, kz = 2;
+  double sx = 0, sy = 0, sz = 1;
+
+  WatertightRay() = default;  // for callers that set it up lazily
+  explicit WatertightRay(const Ray& ray) : origin(ray.origin) {
+    const Vec3& d = ray.direction;
+    const Vec3 absD = abs(d);
+    kz = (absD.x > absD.y) ? (absD.x > absD.z ? 0 : 2) : (absD.y > absD.z ? 1 : 2);
+    kx = (kz + 1) % 3;
+    ky = (kx + 1) % 3;
+    if (d[kz] < 0) std::swap(kx, ky);
+    sx = d[kx] / d[kz];
+    sy = d[ky] / d[kz];
+    sz = 1.0 / d[kz];
+  }
+};
+
+// A candidate hit of the watertight test: t and the unnormalised barycentric weights u, v, w of
+// p0, p1, p2 (the barycentric coordinates are u/det, v/det, w/det; det = u + v + w).
+struct WatertightHit {
+  double t = 0;
+  double u = 0, v = 0, w = 0;
+  double det = 0;
+};
+
+// Watertight ray–triangle intersection (Woop, Benthin and Wald, JCGT 2013), in double. The vertices
+// are translated to the ray origin, permuted and sheared so the ray is +z. The three 2D edge
+// functions then depend only on the two vertices of their edge, so a shared edge gets exactly the
+// opposite (or same) value in both triangles and a ray through it hits at least one of them. Edge
+// functions that round to exactly zero are recomputed in long double, as the paper does in double
+// for its single-precision test; a hit on an edge or vertex counts. Returns the hit with
+// tMin < t < tMax. The caller rejects rays parallel to the plane (isParallelToPlane): that test
+// does not change which rays hit, only where it is made, so it is left until a candidate is found.
+inline bool intersectWatertight(const WatertightRay& r, const Point3& p0, const Point3& p1,
+                                const Point3& p2, double tMin, double tMax, WatertightHit& hit) {
+  using watertight_detail::coordinate;
+  using watertight_detail::edgeFunction;
+  const double az = coordinate(p0, r.kz) - coordinate(r.origin, r.kz);
+  const double bz = coordinate(p1, r.kz) - coordinate(r.origin, r.kz);
+  const double cz = coordinate(p2, r.kz) - coordinate(r.origin, r.kz);
+  const double ax = (coordinate(p0, r.kx) - coordinate(r.origin, r.kx)) - r.sx * az;
+  const double ay = (coordinate(p0, r.ky) - coordinate(r.origin, r.ky)) - r.sy * az;
+  const double bx = (coordinate(p1, r.kx) - coordinate(r.origin, r.kx)) - r.sx * bz;
+  const double by = (coordinate(p1, r.ky) - coordinate(r.origin, r.ky)) - r.sy * bz;
+  const double cx = (coordinate(p2, r.kx) - coordinate(r.origin, r.kx)) - r.sx * cz;
+  const double cy = (coordinate(p2, r.ky) - coordinate(r.origin, r.ky)) - r.sy * cz;
+
+  double u = edgeFunction(cx, by, cy, bx);
+  double v = edgeFunction(ax, cy, ay, cx);
+  double w = edgeFunction(bx, ay, by, ax);
+  if (u == 0 || v == 0 || w == 0) {
+    using Wide = long double;
+    u = static_cast<double>(Wide{cx} * Wide{by} - Wide{cy} * Wide{bx});
+    v = static_cast<double>(Wide{ax} * Wide{cy} - Wide{ay} * Wide{cx});
+    w = static_cast<double>(Wide{bx} * Wide{ay} - Wide{by} * Wide{ax});
+  }
+  if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return false;
+  const double det = u + v + w;
+  if (det == 0) return false;
+
+  const double scaledT = u * (r.sz * az) + v * (r.sz * bz) + w * (r.sz * cz);
+  const double t = scaledT / det;
+  if (!(t > tMin && t < tMax)) return false;
+  hit.t = t;
+  hit.u = u;
+  hit.v = v;
+  hit.w = w;
+  hit.det = det;
+  return true;
+}
+
+}  // namespace glint
