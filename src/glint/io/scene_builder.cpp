@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -16,6 +17,7 @@
 
 #include "glint/core/transform.h"
 #include "glint/geometry/shape.h"
+#include "glint/io/mesh_loader.h"
 #include "glint/io/spelling.h"
 #include "glint/scene/camera.h"
 
@@ -517,6 +519,8 @@ class Builder {
         if (!usable() || !c || !n || !r) return std::nullopt;
         return Disk::make(*c, *n, *r);
       }
+      case ShapeType::Mesh:
+        break;  // not a Shape: buildMesh
     }
     return std::nullopt;
   }
@@ -563,7 +567,81 @@ class Builder {
     error(o.where, prefix + ": " + what);
   }
 
+  // The scene-material index of every material of `file`, added to the scene the first time the
+  // file is used without a material override (a file used twice shares them).
+  const std::vector<std::uint32_t>& fileMaterials(const MeshFile& file) {
+    std::vector<std::uint32_t>& indices = fileMaterials_[&file];
+    if (indices.empty()) {
+      for (const MeshMaterial& m : file.materials) {
+        indices.push_back(static_cast<std::uint32_t>(parts_.materials.size()));
+        parts_.materials.push_back(m.material);
+      }
+    }
+    return indices;
+  }
+
+  // A mesh object (DESIGN.md §5, §7): its file read once per scene through meshCache_, instanced
+  // with the object's transform. The object's `material` replaces every material of the file
+  // (their emission too); its `emission` replaces the files' emission. A file that cannot be
+  // loaded is an error at the object naming the file as written; dropped degenerate triangles are
+  // one warning there.
+  void buildMesh(const ObjectDescription& o) {
+    const bool overridesMaterial = o.inlineMaterial || o.materialName;
+    const std::uint32_t materialIndex = resolveMaterial(o);
+    std::optional<Color> emission;
+    if (o.emission) emission = decode(*o.emission, o.typeName + ".emission").value_or(Color());
+    const std::size_t errorsBefore = errorCount();
+    const std::optional<Transform> worldFromFile = transform(o);
+    const std::string* name = need(o.file, o.complete, o.where, o.typeName, "file");
+    if (name && name->empty()) error(o.file->where, o.typeName + ".file must not be empty");
+    if (!o.complete || !name || errorCount() != errorsBefore) return;
+
+    const std::filesystem::path written(*name);
+    const std::filesystem::path path = written.is_relative() ? d_.baseDirectory / written : written;
+    std::shared_ptr<const MeshFile> file;
+    try {
+      file = meshCache_.load(path);
+    } catch (const MeshLoadError& e) {
+      std::string reason = e.what();
+      if (path != written && reason == "no such file") {
+        reason += fmt::format(" (looked for {}: relative paths start at the scene file's folder)",
+                              path.string());
+      }
+      error(o.where, fmt::format("cannot load mesh file '{}': {}", *name, reason));
+      return;
+    }
+    const std::uint64_t triangles = file->triangleCount();
+    if (meshTriangles_ + triangles > kMaxMeshTriangles) {
+      error(o.where,
+            fmt::format("mesh file '{}' brings the scene's meshes to {} triangles, more than the "
+                        "limit of {}",
+                        *name, formatCount(static_cast<double>(meshTriangles_ + triangles)),
+                        formatCount(static_cast<double>(kMaxMeshTriangles))));
+      return;
+    }
+    meshTriangles_ += triangles;
+    if (file->droppedTriangles > 0) {
+      warning(o.where, fmt::format("mesh file '{}': dropped {} degenerate triangle{} (zero area, "
+                                   "non-finite or invalid vertices); {} remain",
+                                   *name, file->droppedTriangles,
+                                   file->droppedTriangles == 1 ? "" : "s", triangles));
+    }
+    const bool smooth = o.smooth ? o.smooth->value : true;
+    std::vector<TriangleMesh> meshes = instantiateMesh(*file, worldFromFile, smooth);
+    const std::vector<std::uint32_t>* scene = overridesMaterial ? nullptr : &fileMaterials(*file);
+    for (TriangleMesh& mesh : meshes) {
+      const MeshMaterial& own = file->materials[mesh.materialIndex];
+      mesh.emission = emission.value_or(overridesMaterial ? Color() : own.emission);
+      mesh.materialIndex = overridesMaterial ? materialIndex : (*scene)[mesh.materialIndex];
+      parts_.meshes.push_back(std::move(mesh));
+    }
+  }
+
   void buildObject(const ObjectDescription& o) {
+    if (o.type == ShapeType::Mesh) {
+      buildMesh(o);
+      return;
+    }
     const std::uint32_t materialIndex = resolveMaterial(o);
     Color emission;
     if (o.emission) {
@@ -647,14 +725,19 @@ class Builder {
   // Objects shade black without any light, ambient, emission or mirror/glass to show the
   // background; that is almost always a forgotten `lights` or `ambient` section.
   void warnIfUnlit() {
-    if (errorCount() != 0 || parts_.primitives.empty() || !parts_.lights.empty() ||
-        !isBlack(parts_.ambient)) {
+    if (errorCount() != 0 || (parts_.primitives.empty() && parts_.meshes.empty()) ||
+        !parts_.lights.empty() || !isBlack(parts_.ambient)) {
       return;
     }
+    const auto shows = [&](const Color& emission, std::uint32_t material) {
+      const Material& m = parts_.materials[material];
+      return !isBlack(emission) || !isBlack(m.kr) || !isBlack(m.kt);
+    };
     for (const Primitive& p : parts_.primitives) {
-      if (!isBlack(p.emission())) return;
-      const Material& m = parts_.materials[p.materialIndex()];
-      if (!isBlack(m.kr) || !isBlack(m.kt)) return;
+      if (shows(p.emission(), p.materialIndex())) return;
+    }
+    for (const TriangleMesh& mesh : parts_.meshes) {
+      if (shows(mesh.emission, mesh.materialIndex)) return;
     }
     warning({d_.file, 0, 0},
             "the scene has no lights, no ambient light and no emissive, reflective or transparent "
@@ -671,6 +754,9 @@ class Builder {
   std::size_t missing_ = 0;  // required keys found absent in the entity being built
   std::map<std::string, std::uint32_t> materialIndex_;
   std::map<std::string, SourceLocation> materialWhere_;
+  MeshCache meshCache_;  // each mesh file read once per scene
+  std::map<const MeshFile*, std::vector<std::uint32_t>> fileMaterials_;
+  std::uint64_t meshTriangles_ = 0;  // in parts_.meshes
 };
 
 }  // namespace

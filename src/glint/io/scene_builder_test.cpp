@@ -6,15 +6,23 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <variant>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "glint/io/scene_limits.h"
 #include "glint/io/scene_loader.h"
 #include "glint/io/scene_parser.h"
+#include "glint/scene/scene.h"
 
 namespace glint {
 namespace {
@@ -564,6 +572,301 @@ TEST(SceneBuilder, Warnings) {
                               "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1}\n",
                           "lit.yaml")
           .warnings.empty());
+}
+
+// ------------------------------------------------------------------------------------ mesh objects
+
+// A folder of its own under the system's temporary folder for mesh files, removed afterwards.
+class MeshDir {
+ public:
+  MeshDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ = std::filesystem::temp_directory_path() /
+            ("glint_builder_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~MeshDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  void write(const std::string& name, const std::string& text) const {
+    std::ofstream(path_ / name, std::ios::binary) << text;
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// Two unit right triangles in z = 0 with two MTL materials: `red` (Kd, Ks, Ns) and `glow` (Ke).
+constexpr const char* kTwoMaterialObj =
+    "mtllib two.mtl\n"
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+    "usemtl red\nf 1 2 3\n"
+    "usemtl glow\nf 2 4 3\n";
+constexpr const char* kTwoMaterialMtl =
+    "newmtl red\nKd 0.75 0.25 0.125\nKs 0.5 0.5 0.5\nNs 40\n"
+    "newmtl glow\nKd 0 0 0\nKe 2 1.5 1\n";
+
+constexpr const char* kLit = "lights: [{type: point, position: [0, 0, 5]}]\n";
+
+LoadedScene loadIn(const MeshDir& dir, const std::string& text) {
+  return loadSceneFromString(text, "meshes.yaml", dir.path());
+}
+
+std::vector<Diagnostic> meshErrorsOf(const MeshDir& dir, const std::string& text) {
+  try {
+    loadIn(dir, text);
+  } catch (const SceneError& e) {
+    return e.diagnostics();
+  }
+  return {};
+}
+
+const TriangleMesh* meshWithMaterial(const SceneParts& p, const Color& kd) {
+  for (const TriangleMesh& m : p.meshes) {
+    if (p.materials.at(m.materialIndex).kd == kd) return &m;
+  }
+  return nullptr;
+}
+
+TEST(SceneBuilder, MeshObjectTakesTheFilesMaterials) {
+  MeshDir dir;
+  dir.write("two.obj", kTwoMaterialObj);
+  dir.write("two.mtl", kTwoMaterialMtl);
+  const LoadedScene loaded =
+      loadIn(dir, std::string(kMinimal) + kLit + "objects:\n  - {type: mesh, file: two.obj}\n");
+  EXPECT_TRUE(loaded.warnings.empty());
+  const SceneParts& p = loaded.parts;
+  EXPECT_TRUE(p.primitives.empty());
+  ASSERT_EQ(p.meshes.size(), 2u);
+  ASSERT_EQ(p.materials.size(), 3u);  // the default, red, glow
+
+  const TriangleMesh* red = meshWithMaterial(p, Color(0.75, 0.25, 0.125));
+  ASSERT_NE(red, nullptr);
+  const Material& m = p.materials[red->materialIndex];
+  EXPECT_EQ(m.ka, m.kd);
+  EXPECT_EQ(m.ks, Color(0.5));
+  EXPECT_EQ(m.shininess, 40);
+  EXPECT_EQ(m.kr, Color(0));
+  EXPECT_EQ(m.kt, Color(0));
+  EXPECT_EQ(red->emission, Color(0));
+  EXPECT_EQ(red->triangleCount(), 1u);
+
+  const TriangleMesh* glow = meshWithMaterial(p, Color(0));
+  ASSERT_NE(glow, nullptr);
+  EXPECT_EQ(glow->emission, Color(2, 1.5, 1));  // Ke → emission
+
+  // smooth by default: unit vertex normals, here all +z.
+  for (const TriangleMesh& mesh : p.meshes) {
+    ASSERT_EQ(mesh.normals.size(), mesh.positions.size());
+    for (const Normal3& n : mesh.normals) EXPECT_EQ(n, Normal3(0, 0, 1));
+  }
+}
+
+TEST(SceneBuilder, MeshSceneIsHitThroughTheAggregate) {
+  MeshDir dir;
+  dir.write("two.obj", kTwoMaterialObj);
+  dir.write("two.mtl", kTwoMaterialMtl);
+  const Scene scene(loadIn(dir, std::string(kMinimal) + kLit +
+                                    "objects:\n  - {type: mesh, file: two.obj, transform: "
+                                    "[{translate: [0, 0, -5]}]}\n")
+                        .parts);
+  ASSERT_EQ(scene.meshes().size(), 2u);
+  Hit hit;
+  // Straight down the axis onto the red triangle (below the diagonal x + y = 1), at z = −5.
+  ASSERT_TRUE(scene.intersect({{0.25, 0.25, 0}, {0, 0, -1}}, kInfinity, hit));
+  EXPECT_NEAR(hit.t, 5, 1e-12);
+  ASSERT_NE(hit.mesh, kNoMesh);
+  EXPECT_EQ(scene.materialOf(hit).kd, Color(0.75, 0.25, 0.125));
+  EXPECT_EQ(scene.emissionOf(hit), Color(0));
+  EXPECT_NEAR(hit.shadingNormal.z, 1, 1e-12);
+  // Above the diagonal: the glowing triangle.
+  ASSERT_TRUE(scene.intersect({{0.75, 0.75, 0}, {0, 0, -1}}, kInfinity, hit));
+  EXPECT_EQ(scene.emissionOf(hit), Color(2, 1.5, 1));
+  // Beside the square: nothing.
+  EXPECT_FALSE(scene.intersect({{1.5, 0.5, 0}, {0, 0, -1}}, kInfinity, hit));
+}
+
+TEST(SceneBuilder, MeshMaterialAndEmissionOverrideTheFiles) {
+  MeshDir dir;
+  dir.write("two.obj", kTwoMaterialObj);
+  dir.write("two.mtl", kTwoMaterialMtl);
+  const SceneParts named =
+      loadIn(dir, std::string(kMinimal) + kLit +
+                      "materials: {gold: {kd: [0.6, 0.5, 0.1]}}\n"
+                      "objects:\n  - {type: mesh, file: two.obj, material: gold}\n")
+          .parts;
+  ASSERT_EQ(named.materials.size(), 2u);  // the default and gold: none from the file
+  ASSERT_EQ(named.meshes.size(), 2u);
+  for (const TriangleMesh& mesh : named.meshes) {
+    EXPECT_EQ(mesh.materialIndex, 1u);
+    EXPECT_EQ(mesh.emission, Color(0));  // the file's Ke belongs to the replaced material
+  }
+
+  const SceneParts inlined =
+      loadIn(dir, std::string(kMinimal) + kLit +
+                      "objects:\n  - {type: mesh, file: two.obj, material: {kd: 0.3},"
+                      " emission: [0, 0.5, 0]}\n")
+          .parts;
+  ASSERT_EQ(inlined.materials.size(), 2u);
+  for (const TriangleMesh& mesh : inlined.meshes) {
+    EXPECT_EQ(inlined.materials[mesh.materialIndex].kd, Color(0.3));
+    EXPECT_EQ(mesh.emission, Color(0, 0.5, 0));
+  }
+
+  // emission alone replaces the files' emission and keeps their materials.
+  const SceneParts lit = loadIn(dir, std::string(kMinimal) + kLit +
+                                         "objects:\n  - {type: mesh, file: two.obj, "
+                                         "emission: [0.25, 0.25, 0.25]}\n")
+                             .parts;
+  ASSERT_EQ(lit.materials.size(), 3u);
+  for (const TriangleMesh& mesh : lit.meshes) EXPECT_EQ(mesh.emission, Color(0.25));
+}
+
+TEST(SceneBuilder, MeshWithoutAnyMaterialIsMidGrey) {
+  MeshDir dir;
+  dir.write("plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const SceneParts p =
+      loadIn(dir, std::string(kMinimal) + kLit + "objects:\n  - {type: mesh, file: plain.obj}\n")
+          .parts;
+  ASSERT_EQ(p.meshes.size(), 1u);
+  const Material& m = p.materials.at(p.meshes[0].materialIndex);
+  EXPECT_EQ(m.kd, Color(0.7));
+  EXPECT_EQ(m.ka, Color(0.7));
+  EXPECT_EQ(m.ks, Color(0));
+}
+
+TEST(SceneBuilder, MeshTransformAndFlatShading) {
+  MeshDir dir;
+  dir.write("two.obj", kTwoMaterialObj);
+  dir.write("two.mtl", kTwoMaterialMtl);
+  // The same file three times, once through another spelling of its path: read once, so its
+  // materials enter the scene once and all three objects share them.
+  const SceneParts p =
+      loadIn(dir, std::string(kMinimal) + kLit +
+                      "objects:\n"
+                      "  - {type: mesh, file: two.obj}\n"
+                      "  - type: mesh\n"
+                      "    file: ./two.obj\n"
+                      "    smooth: false\n"
+                      "    transform: [{rotate: {axis: [1, 0, 0], angle: 90}}, {scale: 2},"
+                      " {translate: [0, 0, -5]}]\n"
+                      "  - {type: mesh, file: " +
+                      (dir.path() / "two.obj").string() + ", smooth: true}\n")
+          .parts;
+  ASSERT_EQ(p.materials.size(), 3u);
+  ASSERT_EQ(p.meshes.size(), 6u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const TriangleMesh& plain = p.meshes[i];
+    const TriangleMesh& moved = p.meshes[2 + i];
+    const TriangleMesh& absolute = p.meshes[4 + i];
+    EXPECT_EQ(moved.materialIndex, plain.materialIndex);
+    EXPECT_EQ(absolute.materialIndex, plain.materialIndex);
+    EXPECT_EQ(absolute.positions, plain.positions);
+    EXPECT_EQ(moved.indices, plain.indices);
+    EXPECT_TRUE(moved.normals.empty());  // smooth: false
+    EXPECT_EQ(absolute.normals.size(), absolute.positions.size());
+    ASSERT_EQ(moved.positions.size(), plain.positions.size());
+    for (std::size_t v = 0; v < plain.positions.size(); ++v) {
+      // Rotating 90° about x takes (x, y, 0) to (x, 0, y); then ×2 and 5 along −z.
+      const Point3& q = plain.positions[v];
+      expectNear(moved.positions[v], Point3{2 * q.x, 0, 2 * q.y - 5});
+    }
+  }
+}
+
+TEST(SceneBuilder, MeshDegenerateTrianglesAreOneWarningAtTheObject) {
+  MeshDir dir;
+  dir.write("some_flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\nf 2 4 1\n");
+  const LoadedScene loaded = loadIn(dir, std::string(kMinimal) + kLit +
+                                             "objects:\n"
+                                             "  - {type: sphere, center: [0, 0, -5], radius: 1}\n"
+                                             "  - type: mesh\n"
+                                             "    file: some_flat.obj\n");
+  ASSERT_EQ(loaded.warnings.size(), 1u);
+  const Diagnostic& w = loaded.warnings[0];
+  EXPECT_EQ(w.severity, Diagnostic::Severity::Warning);
+  EXPECT_EQ(w.format(),
+            "meshes.yaml:6:5: warning: mesh file 'some_flat.obj': dropped 2 degenerate triangles "
+            "(zero area, non-finite or invalid vertices); 1 remain");
+  ASSERT_EQ(loaded.parts.meshes.size(), 1u);
+  EXPECT_EQ(loaded.parts.meshes[0].triangleCount(), 1u);
+}
+
+TEST(SceneBuilder, MeshFilesThatCannotBeLoadedAreErrorsAtTheObject) {
+  MeshDir dir;
+  dir.write("notes.txt", "Hello, this is not a mesh.\n");
+  dir.write("lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n");
+  std::filesystem::create_directories(dir.path() / "folder.obj");
+  const std::vector<Diagnostic> errors =
+      meshErrorsOf(dir, std::string(kMinimal) + kLit +
+                            "objects:\n"
+                            "  - {type: mesh, file: missing.obj}\n"
+                            "  - {type: sphere, center: [0, 0, -5], radius: 1}\n"
+                            "  - type: mesh\n"
+                            "    file: notes.txt\n"
+                            "  -   {type: mesh, file: folder.obj}\n"
+                            "  - {type: mesh, file: lines.obj}\n"
+                            "  - {type: mesh, file: missing.obj}\n"
+                            "  - {type: mesh, file: ''}\n");
+  ASSERT_EQ(errors.size(), 6u);
+  const std::string looked = (dir.path() / "missing.obj").string();
+  EXPECT_EQ(errors[0].format(),
+            "meshes.yaml:5:5: cannot load mesh file 'missing.obj': no such file (looked for " +
+                looked + ": relative paths start at the scene file's folder)");
+  EXPECT_EQ(errors[1].where.line, 7);
+  EXPECT_EQ(errors[1].where.column, 5);
+  EXPECT_THAT(errors[1].message, HasSubstr("cannot load mesh file 'notes.txt': not a mesh format"));
+  EXPECT_EQ(errors[2].where.line, 9);
+  EXPECT_EQ(errors[2].where.column, 7);
+  EXPECT_THAT(errors[2].message, HasSubstr("'folder.obj': it is a folder, not a mesh file"));
+  EXPECT_EQ(errors[3].where.line, 10);
+  EXPECT_THAT(errors[3].message, HasSubstr("'lines.obj': the file holds no triangles"));
+  // The same missing file again: the same error (from the cache), at its own object.
+  EXPECT_EQ(errors[4].where.line, 11);
+  EXPECT_THAT(errors[4].message, HasSubstr("'missing.obj': no such file"));
+  EXPECT_EQ(errors[5].where.line, 12);
+  EXPECT_THAT(errors[5].message, HasSubstr("mesh.file must not be empty"));
+}
+
+TEST(SceneBuilder, MeshRealFileFromTheTestModels) {
+  // Debian's assimp-testmodels: an absolute path is used as it is.
+  const std::filesystem::path stl = "/usr/share/assimp/models/STL/Spider_binary.stl";
+  ASSERT_TRUE(std::filesystem::is_regular_file(stl))
+      << stl << " is missing: run scripts/setup.sh (it installs assimp-testmodels)";
+  const LoadedScene loaded = loadSceneFromString(
+      std::string(kMinimal) + kLit + "objects:\n  - {type: mesh, file: " + stl.string() +
+          ", transform: [{translate: [0, 0, -10]}]}\n",
+      "spider.yaml");
+  const SceneParts& p = loaded.parts;
+  ASSERT_EQ(p.meshes.size(), 1u);
+  std::uint32_t header = 0;  // the STL's triangle count, after its 80-byte header
+  std::ifstream in(stl, std::ios::binary);
+  in.seekg(80);
+  in.read(reinterpret_cast<char*>(&header), 4);
+  // The spider has facets of zero area (three distinct vertices at one position): the warning
+  // accounts for every triangle of the header that is not in the mesh.
+  ASSERT_LT(p.meshes[0].triangleCount(), header);
+  ASSERT_EQ(loaded.warnings.size(), 1u);
+  EXPECT_EQ(loaded.warnings[0].where.line, 5);
+  EXPECT_THAT(loaded.warnings[0].message,
+              HasSubstr(fmt::format("dropped {} degenerate triangles",
+                                    header - p.meshes[0].triangleCount())));
+  for (const Point3& q : p.meshes[0].positions) ASSERT_LT(q.z, -8);  // the file spans z ±1.65
+}
+
+TEST(SceneBuilder, MeshesCountForTheUnlitWarning) {
+  MeshDir dir;
+  dir.write("plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const LoadedScene dark =
+      loadIn(dir, std::string(kMinimal) + "objects:\n  - {type: mesh, file: plain.obj}\n");
+  ASSERT_EQ(dark.warnings.size(), 1u);
+  EXPECT_THAT(dark.warnings[0].message, HasSubstr("no lights"));
+  EXPECT_TRUE(loadIn(dir, std::string(kMinimal) +
+                              "objects:\n  - {type: mesh, file: plain.obj, emission: [1, 1, 1]}\n")
+                  .warnings.empty());
 }
 
 }  // namespace

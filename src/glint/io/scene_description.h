@@ -54,7 +54,8 @@ enum class ShapeType {
   Tube,
   Cylinder,
   Box,
-  Disk
+  Disk,
+  Mesh  // triangles from a mesh file, loaded by the builder (io/mesh_loader)
 };
 
 // One transform step: translate by `vector`, scale by `vector` (sx, sy, sz), or rotate by `angle`
@@ -82,6 +83,8 @@ struct ObjectDescription {
   std::optional<Located<double>> radius, height;
   std::optional<Located<std::vector<Point3>>> vertices, points;
   std::optional<Located<std::vector<Vec3>>> edges;
+  std::optional<Located<std::string>> file;  // mesh: as written; relative to baseDirectory
+  std::optional<Located<bool>> smooth;       // mesh: interpolated vertex normals (default true)
 
   std::optional<Located<std::string>> materialName;  // a name from `materials`
   std::optional<MaterialDescription> inlineMaterial;
@@ -159,7 +162,7 @@ struct SceneDescription {
   std::optional<ImageDescription> image;
   std::optional<RenderDescription> render;
   std::vector<MaterialDescription> materials;  // named, in file order
-  std::vector<ObjectDescription> objects;      // objects that could be read (mesh ones are not)
+  std::vector<ObjectDescription> objects;      // objects that could be read
   std::vector<LightDescription> lights;
 };
 

@@ -52,7 +52,7 @@ struct ShapeInfo {
   Keys required;  // plane's either/or choice is checked separately
 };
 
-const std::array<ShapeInfo, 10> kShapes{{
+const std::array<ShapeInfo, 11> kShapes{{
     {"sphere", ShapeType::Sphere, {"center", "radius"}, {"center", "radius"}},
     {"plane", ShapeType::Plane, {"point", "normal", "points"}, {}},
     {"triangle", ShapeType::Triangle, {"vertices"}, {"vertices"}},
@@ -66,6 +66,7 @@ const std::array<ShapeInfo, 10> kShapes{{
      {"base", "axis", "radius", "height"}},
     {"box", ShapeType::Box, {"min", "max"}, {"min", "max"}},
     {"disk", ShapeType::Disk, {"center", "normal", "radius"}, {"center", "normal", "radius"}},
+    {"mesh", ShapeType::Mesh, {"file", "smooth"}, {"file"}},
 }};
 
 struct LightInfo {
@@ -225,6 +226,7 @@ class Parser {
   std::optional<ColorValue> color(const Value& v);
   std::optional<Located<Color>> coefficient(const Value& v);
   std::optional<Located<std::string>> text(const Value& v);
+  std::optional<Located<bool>> boolean(const Value& v);
   std::optional<Located<std::vector<Point3>>> pointList(const Value& v, std::size_t minCount,
                                                         std::size_t maxCount);
   std::optional<Located<std::vector<Vec3>>> vectorList(const Value& v, std::size_t count);
@@ -442,6 +444,18 @@ std::optional<Located<std::string>> Parser::text(const Value& v) {
     return std::nullopt;
   }
   return Located<std::string>{v.node.scalar(), v.where};
+}
+
+// YAML 1.2 core-schema booleans only: "yes", "on" and "1" are YAML 1.1 spellings that read as
+// text elsewhere, so they are refused rather than guessed.
+std::optional<Located<bool>> Parser::boolean(const Value& v) {
+  if (v.node.isScalar()) {
+    const std::string& s = v.node.scalar();
+    if (s == "true" || s == "True" || s == "TRUE") return Located<bool>{true, v.where};
+    if (s == "false" || s == "False" || s == "FALSE") return Located<bool>{false, v.where};
+  }
+  error(v.where, fmt::format("{}: expected true or false, got {}", v.path, describe(v.node)));
+  return std::nullopt;
 }
 
 std::optional<Located<std::vector<Point3>>> Parser::pointList(const Value& v, std::size_t minCount,
@@ -740,10 +754,6 @@ void Parser::parseObject(const Value& v, std::size_t index, SceneDescription& sc
                       describe(typeNode)));
   } else {
     object.typeName = typeNode.scalar();
-    if (object.typeName == "mesh") {
-      error(object.where, "mesh objects are not supported yet");
-      return;
-    }
     for (const ShapeInfo& s : kShapes) {
       if (s.name == object.typeName) info = &s;
     }
@@ -787,7 +797,7 @@ void Parser::parseObject(const Value& v, std::size_t index, SceneDescription& sc
   for (const Entry& e : fields.entries) {
     const Value value = valueOf(e, owner);
     const std::string& k = e.key;
-    if (k == "type") continue;
+    if (k == "type" || e.unknown) continue;  // unknown keys are already reported
     if (k == "center") object.center = point3(value);
     if (k == "point") object.point = point3(value);
     if (k == "origin") object.origin = point3(value);
@@ -801,6 +811,8 @@ void Parser::parseObject(const Value& v, std::size_t index, SceneDescription& sc
     if (k == "height") object.height = number(value);
     if (k == "edges") object.edges = vectorList(value, 2);
     if (k == "points") object.points = pointList(value, 3, 3);
+    if (k == "file") object.file = text(value);
+    if (k == "smooth") object.smooth = boolean(value);
     if (k == "vertices") {
       switch (info->type) {
         case ShapeType::Triangle:
@@ -968,6 +980,7 @@ void Parser::parseLight(const Value& v, std::size_t index, SceneDescription& sce
   const Fields fields = readFields(v.node, "in " + owner, &known);
   requireKeys(fields, info->required, light.where, owner);
   for (const Entry& e : fields.entries) {
+    if (e.unknown) continue;  // already reported (another light type's key)
     const Value value = valueOf(e, owner);
     if (e.key == "color") light.color = color(value);
     if (e.key == "intensity") light.intensity = number(value);

@@ -330,9 +330,58 @@ TEST(SceneParser, ConflictingChoicesAtTheLaterKey) {
                  4, 62, "plane has both 'points' and 'point'/'normal'");
 }
 
-TEST(SceneParser, MeshObjectsAreNotSupportedYet) {
-  expectOneError(std::string(kMinimal) + "objects:\n  - type: mesh\n    file: bunny.obj\n", 4, 5,
-                 "mesh objects are not supported yet");
+TEST(SceneParser, MeshKeys) {
+  const ParseResult r = parseScene(std::string(kMinimal) +
+                                       "objects:\n"
+                                       "  - type: mesh\n"
+                                       "    file: models/bunny.obj\n"
+                                       "    smooth: false\n"
+                                       "    material: {kd: 0.5}\n"
+                                       "    emission: [0.1, 0, 0]\n"
+                                       "    transform: [{scale: 2}]\n"
+                                       "  - {type: mesh, file: \"a b.ply\"}\n",
+                                   "test.yaml", "/scenes");
+  ASSERT_FALSE(r.hasErrors()) << r.diagnostics[0].format();
+  const SceneDescription& d = r.description;
+  EXPECT_EQ(d.baseDirectory, std::filesystem::path("/scenes"));
+  ASSERT_EQ(d.objects.size(), 2u);
+  const ObjectDescription& mesh = d.objects[0];
+  EXPECT_EQ(mesh.type, ShapeType::Mesh);
+  EXPECT_EQ(mesh.typeName, "mesh");
+  ASSERT_TRUE(mesh.file);
+  EXPECT_EQ(mesh.file->value, "models/bunny.obj");
+  EXPECT_EQ(mesh.file->where.line, 5);
+  EXPECT_EQ(mesh.file->where.column, 11);
+  ASSERT_TRUE(mesh.smooth);
+  EXPECT_FALSE(mesh.smooth->value);
+  EXPECT_EQ(mesh.smooth->where.line, 6);
+  EXPECT_TRUE(mesh.inlineMaterial);
+  EXPECT_TRUE(mesh.emission);
+  EXPECT_EQ(mesh.transform.size(), 1u);
+  ASSERT_TRUE(d.objects[1].file);
+  EXPECT_EQ(d.objects[1].file->value, "a b.ply");
+  EXPECT_FALSE(d.objects[1].smooth);  // default: the builder's true
+}
+
+TEST(SceneParser, MeshKeyErrors) {
+  const std::string objects = std::string(kMinimal) + "objects:\n";
+  expectOneError(objects + "  - {type: mesh}\n", 4, 5, "mesh is missing required key 'file'");
+  expectOneError(objects + "  - {type: mesh, file: a.obj, smooth: yes}\n", 4, 39,
+                 "mesh.smooth: expected true or false, got 'yes'");
+  expectOneError(objects + "  - {type: mesh, file: [a.obj]}\n", 4, 24,
+                 "mesh.file: expected text, got a list of 1 item");
+  expectOneError(objects + "  - {type: mesh, file: a.obj, smoth: true}\n", 4, 31,
+                 "unknown key 'smoth' in mesh; expected one of: file, smooth, material, emission, "
+                 "transform (did you mean 'smooth'?)");
+  // Another shape's key is only unknown here (one error, not also a type error).
+  expectOneError(objects + "  - {type: mesh, file: a.obj, radius: 1}\n", 4, 31,
+                 "unknown key 'radius' in mesh");
+  expectOneError(objects + "  - {type: sphere, center: [0, 0, 0], radius: 1, file: 1}\n", 4, 50,
+                 "unknown key 'file' in sphere");
+  expectOneError(std::string(kMinimal) +
+                     "lights:\n  - {type: point, position: [0, 0, 0], "
+                     "direction: 1}\n",
+                 4, 40, "unknown key 'direction' in point light");
 }
 
 TEST(SceneParser, UnknownTypesListTheKnownOnes) {
@@ -340,7 +389,7 @@ TEST(SceneParser, UnknownTypesListTheKnownOnes) {
                  "unknown light type 'area'; expected one of: directional, point, spot");
   expectOneError(std::string(kMinimal) + "objects:\n  - {type: sphre}\n", 4, 12,
                  "unknown object type 'sphre'; expected one of: sphere, plane, triangle, polygon, "
-                 "rectangle, quadrangle, tube, cylinder, box, disk (did you mean 'sphere'?)");
+                 "rectangle, quadrangle, tube, cylinder, box, disk, mesh (did you mean 'sphere'?)");
   expectOneError(std::string(kMinimal) + "lights:\n  - {type: ambient}\n", 4, 12,
                  "top-level key 'ambient'");
   expectOneError(std::string(kMinimal) + "image2: {}\n", 3, 1, "did you mean 'image'?");
