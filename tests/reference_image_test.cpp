@@ -1,11 +1,12 @@
-// Reference-image tests: every scene in scenes/ rendered small by the glint command and compared with
-// the checked-in tests/references/<scene>.png. scripts/regenerate-references.sh rewrites the
+// Reference-image tests: every scene in scenes/ rendered small by the glint command and compared
+// with the checked-in tests/references/<scene>.png. scripts/regenerate-references.sh rewrites the
 // references — only on purpose, after looking at the new images.
 //
 // Tolerance: renders are deterministic, so on the machine that made the references the bytes are
 // identical. Other compilers or libm versions may round pow/sin differently, which can move a code
-// by one and, through glossy sampling, a few pixels by more. We accept a mean absolute difference of
-// at most 0.5 codes per channel and at most 0.5% of pixels with any channel off by more than 8 codes.
+// by one and, through glossy sampling, a few pixels by more. We accept a mean absolute difference
+// of at most 0.5 codes per channel and at most 0.5% of pixels with any channel off by more than 8
+// codes.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -59,8 +60,8 @@ TEST_P(ReferenceImage, MatchesCheckedInReference) {
   for (std::size_t pixel = 0; pixel < actual.rgb.size() / 3; ++pixel) {
     int worst = 0;
     for (std::size_t channel = 0; channel < 3; ++channel) {
-      const int difference = std::abs(int(actual.rgb[3 * pixel + channel]) -
-                                      int(expected.rgb[3 * pixel + channel]));
+      const int difference =
+          std::abs(int(actual.rgb[3 * pixel + channel]) - int(expected.rgb[3 * pixel + channel]));
       sumAbsolute += difference;
       worst = std::max(worst, difference);
     }

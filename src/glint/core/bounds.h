@@ -63,8 +63,8 @@ constexpr Bounds3 unite(const Bounds3& a, const Point3& p) {
 
 // Slab test (Kay–Kajiya) against [tMin, tMax]. invDirection = 1/direction per axis (±inf for zero
 // components). The NaN of 0·inf (origin on a slab plane, direction parallel) is treated as inside:
-// std::min/max below return the non-NaN operand, so the test stays conservative. On a hit the clipped
-// interval is returned in tEnter/tExit.
+// std::min/max below return the non-NaN operand, so the test stays conservative. On a hit the
+// clipped interval is returned in tEnter/tExit.
 inline bool intersectSlabs(const Bounds3& b, const Ray& ray, const Vec3& invDirection, double tMin,
                            double tMax, double& tEnter, double& tExit) {
   for (int axis = 0; axis < 3; ++axis) {

@@ -16,16 +16,37 @@ struct Color {
   constexpr Color(double red, double green, double blue) : r(red), g(green), b(blue) {}
   constexpr explicit Color(double grey) : r(grey), g(grey), b(grey) {}
 
-  constexpr Color& operator+=(const Color& c) { r += c.r; g += c.g; b += c.b; return *this; }
-  constexpr Color& operator*=(const Color& c) { r *= c.r; g *= c.g; b *= c.b; return *this; }
-  constexpr Color& operator*=(double s) { r *= s; g *= s; b *= s; return *this; }
+  constexpr Color& operator+=(const Color& c) {
+    r += c.r;
+    g += c.g;
+    b += c.b;
+    return *this;
+  }
+  constexpr Color& operator*=(const Color& c) {
+    r *= c.r;
+    g *= c.g;
+    b *= c.b;
+    return *this;
+  }
+  constexpr Color& operator*=(double s) {
+    r *= s;
+    g *= s;
+    b *= s;
+    return *this;
+  }
   friend constexpr bool operator==(const Color&, const Color&) = default;
 };
 
 // The seed's addColor and multiColorByNumber, and the component-wise product for coefficients.
-constexpr Color operator+(const Color& a, const Color& c) { return {a.r + c.r, a.g + c.g, a.b + c.b}; }
-constexpr Color operator-(const Color& a, const Color& c) { return {a.r - c.r, a.g - c.g, a.b - c.b}; }
-constexpr Color operator*(const Color& a, const Color& c) { return {a.r * c.r, a.g * c.g, a.b * c.b}; }
+constexpr Color operator+(const Color& a, const Color& c) {
+  return {a.r + c.r, a.g + c.g, a.b + c.b};
+}
+constexpr Color operator-(const Color& a, const Color& c) {
+  return {a.r - c.r, a.g - c.g, a.b - c.b};
+}
+constexpr Color operator*(const Color& a, const Color& c) {
+  return {a.r * c.r, a.g * c.g, a.b * c.b};
+}
 constexpr Color operator*(const Color& a, double s) { return {a.r * s, a.g * s, a.b * s}; }
 constexpr Color operator*(double s, const Color& a) { return {a.r * s, a.g * s, a.b * s}; }
 constexpr Color operator/(const Color& a, double s) { return {a.r / s, a.g / s, a.b / s}; }

@@ -5,8 +5,8 @@
 
 namespace glint {
 
-// A ray P(t) = origin + t·direction. The direction need not be unit (object-space rays of transformed
-// shapes are not); t is then measured in multiples of the direction's length.
+// A ray P(t) = origin + t·direction. The direction need not be unit (object-space rays of
+// transformed shapes are not); t is then measured in multiples of the direction's length.
 struct Ray {
   Point3 origin;
   Vec3 direction;

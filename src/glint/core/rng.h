@@ -14,10 +14,12 @@ constexpr std::uint64_t mix64(std::uint64_t z) {
   return z ^ (z >> 31);
 }
 
-constexpr std::uint64_t hashCombine(std::uint64_t a, std::uint64_t b) { return mix64(a ^ mix64(b)); }
+constexpr std::uint64_t hashCombine(std::uint64_t a, std::uint64_t b) {
+  return mix64(a ^ mix64(b));
+}
 
-// A stream of uniform numbers: value k is mix64(key + k). Cheap to create per pixel sample, holds no
-// shared state, and never depends on scheduling.
+// A stream of uniform numbers: value k is mix64(key + k). Cheap to create per pixel sample, holds
+// no shared state, and never depends on scheduling.
 class Rng {
  public:
   constexpr Rng() = default;

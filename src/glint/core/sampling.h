@@ -21,9 +21,10 @@ inline double radicalInverse2(std::uint32_t index, std::uint32_t scramble = 0) {
   return static_cast<double>(bits) * 0x1.0p-32;
 }
 
-// Point k of an n-point stratified 2D pattern in [0,1)²: a jittered m×m grid when n = m², otherwise a
-// Hammersley-style set (k + jitter)/n against the scrambled radical inverse of k. Both put exactly one
-// point in each of n strata along x. jitterX/jitterY in [0,1) come from the caller's Rng.
+// Point k of an n-point stratified 2D pattern in [0,1)²: a jittered m×m grid when n = m², otherwise
+// a Hammersley-style set (k + jitter)/n against the scrambled radical inverse of k. Both put
+// exactly one point in each of n strata along x. jitterX/jitterY in [0,1) come from the caller's
+// Rng.
 inline Point2 stratified2D(std::uint32_t k, std::uint32_t n, double jitterX, double jitterY,
                            std::uint32_t scramble) {
   const auto m = static_cast<std::uint32_t>(std::lround(std::sqrt(static_cast<double>(n))));

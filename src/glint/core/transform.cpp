@@ -126,7 +126,9 @@ Normal3 Transform::operator()(const Normal3& n) const {
           mi[0][2] * n.x + mi[1][2] * n.y + mi[2][2] * n.z};
 }
 
-Ray Transform::operator()(const Ray& r) const { return Ray{(*this)(r.origin), (*this)(r.direction)}; }
+Ray Transform::operator()(const Ray& r) const {
+  return Ray{(*this)(r.origin), (*this)(r.direction)};
+}
 
 Bounds3 Transform::operator()(const Bounds3& b) const {
   if (b.isEmpty()) return b;

@@ -1,5 +1,6 @@
-// Affine transforms (4×4 matrices with their inverses) applied to points, vectors, normals, rays and
-// bounds. Named destination-from-source: worldFromObject maps object-space coordinates to world space.
+// Affine transforms (4×4 matrices with their inverses) applied to points, vectors, normals, rays
+// and bounds. Named destination-from-source: worldFromObject maps object-space coordinates to world
+// space.
 #pragma once
 
 #include <array>
@@ -40,7 +41,8 @@ class TransformError : public std::invalid_argument {
 class Transform {
  public:
   Transform() = default;  // identity
-  Transform(const Matrix4& matrix, const Matrix4& inverseMatrix) : m_(matrix), mInv_(inverseMatrix) {}
+  Transform(const Matrix4& matrix, const Matrix4& inverseMatrix)
+      : m_(matrix), mInv_(inverseMatrix) {}
   explicit Transform(const Matrix4& matrix) : m_(matrix), mInv_(glint::inverse(matrix)) {}
 
   static Transform translate(const Vec3& delta);

@@ -1,4 +1,5 @@
-// Distinct 3D vector, point and normal types (double precision) and the algebra allowed between them.
+// Distinct 3D vector, point and normal types (double precision) and the algebra allowed between
+// them.
 #pragma once
 
 #include <algorithm>
@@ -21,9 +22,24 @@ struct Vec3 {
   constexpr double operator[](int axis) const { return axis == 0 ? x : (axis == 1 ? y : z); }
   constexpr double& operator[](int axis) { return axis == 0 ? x : (axis == 1 ? y : z); }
   constexpr Vec3 operator-() const { return {-x, -y, -z}; }
-  constexpr Vec3& operator+=(const Vec3& v) { x += v.x; y += v.y; z += v.z; return *this; }
-  constexpr Vec3& operator-=(const Vec3& v) { x -= v.x; y -= v.y; z -= v.z; return *this; }
-  constexpr Vec3& operator*=(double s) { x *= s; y *= s; z *= s; return *this; }
+  constexpr Vec3& operator+=(const Vec3& v) {
+    x += v.x;
+    y += v.y;
+    z += v.z;
+    return *this;
+  }
+  constexpr Vec3& operator-=(const Vec3& v) {
+    x -= v.x;
+    y -= v.y;
+    z -= v.z;
+    return *this;
+  }
+  constexpr Vec3& operator*=(double s) {
+    x *= s;
+    y *= s;
+    z *= s;
+    return *this;
+  }
   friend constexpr bool operator==(const Vec3&, const Vec3&) = default;
 };
 
@@ -35,8 +51,18 @@ struct Point3 {
 
   constexpr double operator[](int axis) const { return axis == 0 ? x : (axis == 1 ? y : z); }
   constexpr double& operator[](int axis) { return axis == 0 ? x : (axis == 1 ? y : z); }
-  constexpr Point3& operator+=(const Vec3& v) { x += v.x; y += v.y; z += v.z; return *this; }
-  constexpr Point3& operator-=(const Vec3& v) { x -= v.x; y -= v.y; z -= v.z; return *this; }
+  constexpr Point3& operator+=(const Vec3& v) {
+    x += v.x;
+    y += v.y;
+    z += v.z;
+    return *this;
+  }
+  constexpr Point3& operator-=(const Vec3& v) {
+    x -= v.x;
+    y -= v.y;
+    z -= v.z;
+    return *this;
+  }
   friend constexpr bool operator==(const Point3&, const Point3&) = default;
 };
 
@@ -75,9 +101,15 @@ inline bool isFinite(const Vec3& v) {
 }
 
 // --- Point3 algebra ---
-constexpr Point3 operator+(const Point3& p, const Vec3& v) { return {p.x + v.x, p.y + v.y, p.z + v.z}; }
-constexpr Point3 operator-(const Point3& p, const Vec3& v) { return {p.x - v.x, p.y - v.y, p.z - v.z}; }
-constexpr Vec3 operator-(const Point3& a, const Point3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+constexpr Point3 operator+(const Point3& p, const Vec3& v) {
+  return {p.x + v.x, p.y + v.y, p.z + v.z};
+}
+constexpr Point3 operator-(const Point3& p, const Vec3& v) {
+  return {p.x - v.x, p.y - v.y, p.z - v.z};
+}
+constexpr Vec3 operator-(const Point3& a, const Point3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
 constexpr Vec3 toVec(const Point3& p) { return {p.x, p.y, p.z}; }
 constexpr Point3 toPoint(const Vec3& v) { return {v.x, v.y, v.z}; }
 inline double distance(const Point3& a, const Point3& b) { return length(a - b); }

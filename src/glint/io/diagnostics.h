@@ -18,7 +18,8 @@ struct Diagnostic {
   enum class Severity { Error, Warning };
   Severity severity = Severity::Error;
   SourceLocation where;
-  std::string message;  // what is wrong and what was expected, e.g. "sphere.radius must be > 0, got -2"
+  std::string
+      message;  // what is wrong and what was expected, e.g. "sphere.radius must be > 0, got -2"
 
   // "FILE:LINE:COL: message" for errors, "FILE:LINE:COL: warning: message" for warnings;
   // "FILE: message" when there is no line.

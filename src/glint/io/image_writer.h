@@ -1,6 +1,6 @@
-// Image output: PNG (8-bit, libpng), PPM (8-bit binary P6) and OpenEXR (linear float), chosen by the
-// file extension. Every writer writes a temporary file beside the target and renames it into place,
-// so an existing file is only ever replaced by a complete image.
+// Image output: PNG (8-bit, libpng), PPM (8-bit binary P6) and OpenEXR (linear float), chosen by
+// the file extension. Every writer writes a temporary file beside the target and renames it into
+// place, so an existing file is only ever replaced by a complete image.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,7 @@
-// Scene files (DESIGN.md §5): YAML/JSON text → SceneDescription (plain data with the file:line:col of
-// every entity; io/scene_description.h) → SceneParts (render objects; scene/scene.h). Strict: an
-// unknown key, a wrong type, a missing required key or an invalid value is an error naming its place.
+// Scene files (DESIGN.md §5): YAML/JSON text → SceneDescription (plain data with the file:line:col
+// of every entity; io/scene_description.h) → SceneParts (render objects; scene/scene.h). Strict: an
+// unknown key, a wrong type, a missing required key or an invalid value is an error naming its
+// place.
 #pragma once
 
 #include <filesystem>

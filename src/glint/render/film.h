@@ -21,7 +21,9 @@ class Film {
   Film() = default;
   // A film covering `region` of a fullWidth × fullHeight image.
   Film(int fullWidth, int fullHeight, const PixelRegion& region)
-      : fullWidth_(fullWidth), fullHeight_(fullHeight), region_(region),
+      : fullWidth_(fullWidth),
+        fullHeight_(fullHeight),
+        region_(region),
         pixels_(static_cast<std::size_t>(region.width()) * region.height()) {}
 
   int width() const { return region_.width(); }

@@ -25,15 +25,15 @@ struct RayCounts {
 
 struct RenderStats {
   RayCounts rays;
-  double seconds = 0;          // wall-clock time of the render
-  std::uint64_t nonFinite = 0; // samples that came out NaN/inf and were replaced by black
+  double seconds = 0;           // wall-clock time of the render
+  std::uint64_t nonFinite = 0;  // samples that came out NaN/inf and were replaced by black
   bool cancelled = false;
 };
 
 struct RenderOptions {
-  int threads = 0;                        // 0 = all cores
-  std::optional<PixelRegion> crop;        // default: the whole image
-  int tileSize = 16;                      // pixels per tile side
+  int threads = 0;                            // 0 = all cores
+  std::optional<PixelRegion> crop;            // default: the whole image
+  int tileSize = 16;                          // pixels per tile side
   const std::atomic<bool>* cancel = nullptr;  // polled between tiles; when set, render stops
   // Called (from worker threads, serialised by the renderer) after each finished tile with
   // (tiles done, tiles total).

@@ -14,10 +14,10 @@ class CameraError : public std::invalid_argument {
 };
 
 struct CameraSpec {
-  Point3 position;           // p0, the centre of projection
-  Vec3 direction{0, 0, -1};  // vTo, any non-zero length
-  Vec3 up{0, 1, 0};          // vUp, re-orthogonalised against vTo; parallel to vTo is an error
-  double viewPlaneWidth = 0;     // scene units (set these three, or fovDegrees)
+  Point3 position;            // p0, the centre of projection
+  Vec3 direction{0, 0, -1};   // vTo, any non-zero length
+  Vec3 up{0, 1, 0};           // vUp, re-orthogonalised against vTo; parallel to vTo is an error
+  double viewPlaneWidth = 0;  // scene units (set these three, or fovDegrees)
   double viewPlaneHeight = 0;
   double viewPlaneDistance = 0;
   double fovDegrees = 0;     // vertical field of view in (0, 180); if > 0, replaces the view plane

@@ -42,9 +42,9 @@ using Light = std::variant<DirectionalLight, PointLight, SpotLight>;
 
 // What a light delivers to a point P.
 struct LightSample {
-  Vec3 toPoint;        // l: unit vector from the light to P
-  double distance = 0; // from P to the light; infinity for directional lights
-  Color intensity;     // I_L(P) before shadowing
+  Vec3 toPoint;         // l: unit vector from the light to P
+  double distance = 0;  // from P to the light; infinity for directional lights
+  Color intensity;      // I_L(P) before shadowing
 };
 
 // I_L(P) and l for any light (DESIGN.md §3). P at the position of a point/spot light gives zero

@@ -5,18 +5,18 @@
 
 namespace glint {
 
-// Every coefficient may be an RGB triple (a number in a scene file means the same value in r, g, b).
-// Defaults are the scene format's: all 0 but ka = 1 and ior = 1.
+// Every coefficient may be an RGB triple (a number in a scene file means the same value in r, g,
+// b). Defaults are the scene format's: all 0 but ka = 1 and ior = 1.
 struct Material {
-  Color kd;                     // diffuse
-  Color ks;                     // specular (Phong highlight)
-  double shininess = 0;         // Phong exponent
-  Color kr;                     // mirror reflection
-  Color kt;                     // transmission; also the factor a shadow ray keeps per crossing
-  Color ka{1, 1, 1};            // ambient
-  double ior = 1;               // index of refraction; 1 = straight through
-  double reflectionBlur = 0;    // glossy cone half-angle, degrees
-  double refractionBlur = 0;    // glossy cone half-angle, degrees
+  Color kd;                   // diffuse
+  Color ks;                   // specular (Phong highlight)
+  double shininess = 0;       // Phong exponent
+  Color kr;                   // mirror reflection
+  Color kt;                   // transmission; also the factor a shadow ray keeps per crossing
+  Color ka{1, 1, 1};          // ambient
+  double ior = 1;             // index of refraction; 1 = straight through
+  double reflectionBlur = 0;  // glossy cone half-angle, degrees
+  double refractionBlur = 0;  // glossy cone half-angle, degrees
 };
 
 }  // namespace glint
