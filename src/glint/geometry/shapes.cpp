@@ -181,6 +181,24 @@ Bounds3 diskBounds(const Point3& c, const Vec3& n, double r) {
   return Bounds3(c - half, c + half);
 }
 
+// Unit normal (b−a)×(c−a) of three finite, non-collinear points named `key` in messages. Degenerate
+// when twice the area |e1×e2| ≤ kCollinearTolerance · (longest edge)²: the triangle is then thinner
+// than that fraction of its longest edge (or has coincident vertices).
+Normal3 nonCollinearNormal(const char* key, const Point3& a, const Point3& b, const Point3& c) {
+  const Point3 points[3] = {a, b, c};
+  for (int i = 0; i < 3; ++i) {
+    if (!isFinite(points[i]))
+      throw ShapeError(fmt::format("{}[{}] must be finite, got {}", key, i, format(points[i])));
+  }
+  const Vec3 n = cross(b - a, c - a);
+  const double longest =
+      std::max({distanceSquared(a, b), distanceSquared(b, c), distanceSquared(c, a)});
+  if (length(n) <= kCollinearTolerance * longest)
+    throw ShapeError(
+        fmt::format("{} are collinear: {}, {}, {}", key, format(a), format(b), format(c)));
+  return Normal3(normalize(n));
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------- Sphere
@@ -230,18 +248,7 @@ Plane Plane::make(const Point3& point, const Vec3& normal) {
 }
 
 Plane Plane::fromPoints(const Point3& a, const Point3& b, const Point3& c) {
-  const Point3 points[3] = {a, b, c};
-  for (int i = 0; i < 3; ++i) {
-    if (!isFinite(points[i]))
-      throw ShapeError(fmt::format("points[{}] must be finite, got {}", i, format(points[i])));
-  }
-  const Vec3 n = cross(b - a, c - a);
-  const double longest =
-      std::max({distanceSquared(a, b), distanceSquared(b, c), distanceSquared(c, a)});
-  if (length(n) <= kCollinearTolerance * longest)
-    throw ShapeError(
-        fmt::format("points are collinear: {}, {}, {}", format(a), format(b), format(c)));
-  return Plane{a, Normal3(normalize(n))};
+  return Plane{a, nonCollinearNormal("points", a, b, c)};
 }
 
 bool Plane::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
@@ -263,21 +270,8 @@ Normal3 Plane::normalAt(const Point3&) const { return normal; }
 
 // -------------------------------------------------------------------------------------- Triangle
 
-// Degenerate when twice the area |e1×e2| ≤ 1e-12 · (longest edge)²: the triangle is then thinner
-// than 1e-12 of its longest edge (or has coincident vertices).
 Triangle Triangle::make(const Point3& v0, const Point3& v1, const Point3& v2) {
-  const Point3 vertices[3] = {v0, v1, v2};
-  for (int i = 0; i < 3; ++i) {
-    if (!isFinite(vertices[i]))
-      throw ShapeError(fmt::format("vertices[{}] must be finite, got {}", i, format(vertices[i])));
-  }
-  const Vec3 n = cross(v1 - v0, v2 - v0);
-  const double longest =
-      std::max({distanceSquared(v0, v1), distanceSquared(v1, v2), distanceSquared(v2, v0)});
-  if (length(n) <= kCollinearTolerance * longest)
-    throw ShapeError(
-        fmt::format("vertices are collinear: {}, {}, {}", format(v0), format(v1), format(v2)));
-  return Triangle{v0, v1, v2, Normal3(normalize(n))};
+  return Triangle{v0, v1, v2, nonCollinearNormal("vertices", v0, v1, v2)};
 }
 
 // The watertight test of watertight_triangle.h (Woop, Benthin and Wald 2013): rays through a shared
