@@ -364,6 +364,15 @@ TEST_F(Cli, CheckPrintsASummaryAndWritesNothing) {
   EXPECT_TRUE(filesIn(work_).empty());
 }
 
+// scenes/mesh.yaml places scenes/meshes/torus_knot.obj (38,400 triangles, one material) twice.
+TEST_F(Cli, CheckCountsMeshesAndTheirTriangles) {
+  const RunResult r =
+      run({"check", (std::filesystem::path(GLINT_SOURCE_DIR) / "scenes" / "mesh.yaml").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "meshes:    2 (76800 triangles)")) << r.out;
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
 TEST_F(Cli, CheckReportsTheSameErrorsAsRender) {
   const std::string scene = (kBroken / "negative_radius.yaml").string();
   const RunResult check = run({"check", scene});

@@ -255,6 +255,8 @@ int runCheck(const std::string& file) {
                       image.encoding == Encoding::Srgb ? "srgb" : "linear");
   text += fmt::format("objects:   {} ({} bounded, {} unbounded)\n", primitives,
                       primitives - unbounded, unbounded);
+  text += fmt::format("meshes:    {} ({} triangles)\n", scene.meshes().size(),
+                      scene.aggregate().triangleCount());
   text += fmt::format("lights:    {}\n", lightsText(scene));
   text += fmt::format("materials: {}\n", materialCount(scene));
   text += fmt::format("bounds:    {}\n", formatBounds(scene));
