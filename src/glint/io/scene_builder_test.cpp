@@ -22,12 +22,16 @@
 #include "glint/io/scene_limits.h"
 #include "glint/io/scene_loader.h"
 #include "glint/io/scene_parser.h"
+#include "glint/io/scene_test_support.h"
 #include "glint/scene/scene.h"
 
 namespace glint {
 namespace {
 
+using testing::errorsOf;
+using testing::expectOneError;
 using ::testing::HasSubstr;
+using testing::kMinimal;
 
 constexpr const char* kDesignExample = R"(name: basic render
 background: "#4b7f5a"
@@ -59,28 +63,6 @@ lights:
   - { type: spot, position: [-50, -50, 50], direction: [1, 1, -2], color: [1, 0.6, 0],
       intensity: 1, attenuation: [1, 0.00001, 0.00000001], exponent: 1 }
 )";
-
-constexpr const char* kMinimal =
-    "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
-    "image: {width: 4, height: 3}\n";
-
-std::vector<Diagnostic> errorsOf(const std::string& text) {
-  try {
-    loadSceneFromString(text, "test.yaml");
-  } catch (const SceneError& e) {
-    return e.diagnostics();
-  }
-  return {};
-}
-
-void expectOneError(const std::string& text, int line, int column, const std::string& fragment) {
-  SCOPED_TRACE(text);
-  const std::vector<Diagnostic> errors = errorsOf(text);
-  ASSERT_EQ(errors.size(), 1u) << (errors.empty() ? "no error" : errors[0].format());
-  EXPECT_EQ(errors[0].where.line, line) << errors[0].format();
-  EXPECT_EQ(errors[0].where.column, column) << errors[0].format();
-  EXPECT_THAT(errors[0].message, HasSubstr(fragment));
-}
 
 // Loads a scene that must be valid.
 SceneParts partsOf(const std::string& text) {

@@ -15,11 +15,15 @@
 #include <vector>
 
 #include "glint/io/scene_loader.h"
+#include "glint/io/scene_test_support.h"
 
 namespace glint {
 namespace {
 
+using testing::errorsOf;
+using testing::expectOneError;
 using ::testing::HasSubstr;
+using testing::kMinimal;
 
 // The scene of DESIGN.md §5, verbatim.
 constexpr const char* kDesignExample = R"(name: basic render                 # optional
@@ -55,30 +59,6 @@ lights:
 )";
 
 // The smallest valid scene; tests append the keys they exercise.
-constexpr const char* kMinimal =
-    "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
-    "image: {width: 4, height: 3}\n";
-
-std::vector<Diagnostic> errorsOf(const std::string& text) {
-  try {
-    loadSceneFromString(text, "test.yaml");
-  } catch (const SceneError& e) {
-    return e.diagnostics();
-  }
-  return {};
-}
-
-// Expects exactly one error, at line:column, whose message contains `fragment`.
-void expectOneError(const std::string& text, int line, int column, const std::string& fragment) {
-  const std::vector<Diagnostic> errors = errorsOf(text);
-  ASSERT_EQ(errors.size(), 1u) << text << "\nfirst: " << (errors.empty() ? "" : errors[0].format());
-  EXPECT_EQ(errors[0].where.file, "test.yaml");
-  EXPECT_EQ(errors[0].where.line, line) << errors[0].format();
-  EXPECT_EQ(errors[0].where.column, column) << errors[0].format();
-  EXPECT_THAT(errors[0].message, HasSubstr(fragment));
-  EXPECT_EQ(errors[0].severity, Diagnostic::Severity::Error);
-}
-
 TEST(SceneParser, DesignExampleParsesWithLocations) {
   const ParseResult r = parseScene(kDesignExample, "scene.yaml", "/scenes");
   ASSERT_FALSE(r.hasErrors()) << r.diagnostics[0].format();
