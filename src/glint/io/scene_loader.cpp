@@ -75,9 +75,10 @@ bool before(const Diagnostic& a, const Diagnostic& b) {
 }  // namespace
 
 LoadedScene loadSceneFromString(std::string_view text, const std::string& displayName,
-                                const std::filesystem::path& baseDirectory) {
+                                const std::filesystem::path& baseDirectory,
+                                const LoadOptions& options) {
   ParseResult parsed = parseScene(text, displayName, baseDirectory);
-  BuildResult built = buildScene(parsed.description);
+  BuildResult built = buildScene(parsed.description, BuildOptions{options.memoryBudget});
 
   std::vector<Diagnostic> errors;
   std::vector<Diagnostic> warnings;
@@ -93,12 +94,12 @@ LoadedScene loadSceneFromString(std::string_view text, const std::string& displa
   return LoadedScene{std::move(built.parts), std::move(warnings)};
 }
 
-LoadedScene loadScene(const std::filesystem::path& file) {
+LoadedScene loadScene(const std::filesystem::path& file, const LoadOptions& options) {
   const std::string name = file.string();
   const std::string text = readFile(file, name);
   std::filesystem::path base = file.parent_path();
   if (base.empty()) base = ".";
-  return loadSceneFromString(text, name, base);
+  return loadSceneFromString(text, name, base, options);
 }
 
 }  // namespace glint

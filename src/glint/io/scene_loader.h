@@ -4,12 +4,14 @@
 // place.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "glint/io/diagnostics.h"
+#include "glint/io/scene_limits.h"
 #include "glint/scene/scene.h"
 
 namespace glint {
@@ -19,13 +21,20 @@ struct LoadedScene {
   std::vector<Diagnostic> warnings;
 };
 
+struct LoadOptions {
+  // Bytes the scene may need (film now; meshes and BVH estimated before loading): the limit of
+  // DESIGN.md §7, set by `--max-memory`.
+  std::uint64_t memoryBudget = defaultImageMemoryBudget();
+};
+
 // Reads, parses and builds a scene file. Throws SceneError carrying every error found (up to 20);
 // a missing, unreadable or directory path is an error naming only the file.
-LoadedScene loadScene(const std::filesystem::path& file);
+LoadedScene loadScene(const std::filesystem::path& file, const LoadOptions& options = {});
 
 // The same for text in memory. `displayName` names the text in messages; relative paths inside it
 // (mesh files) resolve from `baseDirectory`.
 LoadedScene loadSceneFromString(std::string_view text, const std::string& displayName,
-                                const std::filesystem::path& baseDirectory = ".");
+                                const std::filesystem::path& baseDirectory = ".",
+                                const LoadOptions& options = {});
 
 }  // namespace glint

@@ -257,11 +257,31 @@ Color traceRay(const Scene& scene, const Ray& ray, Rng& rng, RayCounts* counts) 
   return traceCameraRay(ctx, ray);
 }
 
+std::vector<PixelRegion> tileRegions(const PixelRegion& region, int tileSize) {
+  if (tileSize <= 0) throw std::invalid_argument("tile size must be > 0");
+  std::vector<PixelRegion> tiles;
+  for (int y0 = region.y0; y0 < region.y1; y0 += tileSize) {
+    for (int x0 = region.x0; x0 < region.x1; x0 += tileSize) {
+      tiles.push_back(PixelRegion{x0, y0, std::min(x0 + tileSize, region.x1),
+                                  std::min(y0 + tileSize, region.y1)});
+    }
+  }
+  return tiles;
+}
+
 Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats) {
   const auto start = std::chrono::steady_clock::now();
   const PixelRegion region = validatedRegion(scene, options);
-  if (options.tileSize <= 0) throw std::invalid_argument("tile size must be > 0");
   if (options.threads < 0) throw std::invalid_argument("thread count must be ≥ 0");
+  const std::vector<PixelRegion> tiles = tileRegions(region, options.tileSize);
+  const std::size_t tileCount = tiles.size();
+  const bool resuming = options.resumeFilm != nullptr && options.resumeTiles != nullptr;
+  if (resuming && (options.resumeFilm->region() != region ||
+                   options.resumeFilm->fullWidth() != scene.image().width ||
+                   options.resumeFilm->fullHeight() != scene.image().height ||
+                   options.resumeTiles->size() != tileCount)) {
+    throw std::invalid_argument("the film to resume from covers a different image or region");
+  }
 
   const ImageSettings& image = scene.image();
   Film film(image.width, image.height, region);
@@ -270,31 +290,46 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
   const auto sampleCount = static_cast<std::uint32_t>(samples);
   const std::uint64_t seed = scene.render().seed;
 
-  const int tileSize = options.tileSize;
-  const int tilesX = (region.width() + tileSize - 1) / tileSize;
-  const int tilesY = (region.height() + tileSize - 1) / tileSize;
-  const auto tileCount = static_cast<std::size_t>(tilesX) * static_cast<std::size_t>(tilesY);
-
   std::atomic<std::uint64_t> cameraRays{0}, shadowRays{0}, reflectionRays{0}, refractionRays{0};
   std::atomic<std::uint64_t> nonFinite{0};
   std::atomic<bool> cancelled{false};
-  std::mutex progressMutex;
+  std::mutex progressMutex;  // guards tilesDone, firstNonFinite and the callbacks
   std::size_t tilesDone = 0;
+  std::size_t tilesResumed = 0;
+  std::optional<PixelCoord> firstNonFinite;
+  const auto before = [](const PixelCoord& a, const PixelCoord& b) {
+    return a.y != b.y ? a.y < b.y : a.x < b.x;
+  };
+
+  if (resuming) {
+    for (std::size_t tile = 0; tile < tileCount; ++tile) {
+      if (!(*options.resumeTiles)[tile]) continue;
+      const PixelRegion& t = tiles[tile];
+      for (int y = t.y0; y < t.y1; ++y) {
+        for (int x = t.x0; x < t.x1; ++x) {
+          film.at(x - region.x0, y - region.y0) =
+              options.resumeFilm->at(x - region.x0, y - region.y0);
+        }
+      }
+      ++tilesResumed;
+    }
+    tilesDone = tilesResumed;
+  }
 
   auto renderTile = [&](std::size_t tile) {
+    if (resuming && (*options.resumeTiles)[tile]) return;
     if (cancelled.load(std::memory_order_relaxed)) return;
     if (options.cancel && options.cancel->load()) {
       cancelled.store(true);
       return;
     }
-    const int tx = static_cast<int>(tile % static_cast<std::size_t>(tilesX));
-    const int ty = static_cast<int>(tile / static_cast<std::size_t>(tilesX));
-    const int x0 = region.x0 + tx * tileSize;
-    const int y0 = region.y0 + ty * tileSize;
-    const int x1 = std::min(x0 + tileSize, region.x1);
-    const int y1 = std::min(y0 + tileSize, region.y1);
+    const int x0 = tiles[tile].x0;
+    const int y0 = tiles[tile].y0;
+    const int x1 = tiles[tile].x1;
+    const int y1 = tiles[tile].y1;
     RayCounts counts;
     std::uint64_t tileNonFinite = 0;
+    std::optional<PixelCoord> tileFirstNonFinite;
     for (int row = y0; row < y1; ++row) {
       for (int column = x0; column < x1; ++column) {
         const std::uint32_t scramble = samples > 1 ? pixelScramble(column, row, seed) : 0;
@@ -317,7 +352,7 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
           Color value = traceCameraRay(ctx, ray);
           if (!isFinite(value)) {
             value = Color{};
-            ++tileNonFinite;
+            if (tileNonFinite++ == 0) tileFirstNonFinite = PixelCoord{column, row};
           }
           sum += value;
         }
@@ -329,10 +364,13 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
     reflectionRays += counts.reflection;
     refractionRays += counts.refraction;
     nonFinite += tileNonFinite;
-    if (options.progress) {
-      const std::lock_guard<std::mutex> lock(progressMutex);
-      options.progress(++tilesDone, tileCount);
+    const std::lock_guard<std::mutex> lock(progressMutex);
+    if (tileFirstNonFinite && (!firstNonFinite || before(*tileFirstNonFinite, *firstNonFinite))) {
+      firstNonFinite = tileFirstNonFinite;
     }
+    ++tilesDone;
+    if (options.tileFinished) options.tileFinished(tile, film);
+    if (options.progress) options.progress(tilesDone, tileCount);
   };
 
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
@@ -353,6 +391,8 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
     stats->rays.reflection = reflectionRays.load();
     stats->rays.refraction = refractionRays.load();
     stats->nonFinite = nonFinite.load();
+    stats->firstNonFinite = firstNonFinite;
+    stats->tilesResumed = tilesResumed;
     stats->cancelled = cancelled.load();
     stats->seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

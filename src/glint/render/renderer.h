@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <vector>
 
 #include "glint/core/color.h"
 #include "glint/core/rng.h"
@@ -23,10 +24,20 @@ struct RayCounts {
   std::uint64_t total() const { return camera + shadow + reflection + refraction; }
 };
 
+// A pixel in full-image coordinates (row 0 at the top).
+struct PixelCoord {
+  int x = 0, y = 0;
+  friend bool operator==(const PixelCoord&, const PixelCoord&) = default;
+};
+
 struct RenderStats {
-  RayCounts rays;
+  RayCounts rays;               // rays.camera is also the number of pixel samples spent
   double seconds = 0;           // wall-clock time of the render
   std::uint64_t nonFinite = 0;  // samples that came out NaN/inf and were replaced by black
+  // Where the first non-finite sample arose: the smallest row, then column, among the pixels that
+  // had one (so the same on any thread count).
+  std::optional<PixelCoord> firstNonFinite;
+  std::size_t tilesResumed = 0;  // tiles copied from RenderOptions::resumeFilm, not rendered
   bool cancelled = false;
 };
 
@@ -38,7 +49,20 @@ struct RenderOptions {
   // Called (from worker threads, serialised by the renderer) after each finished tile with
   // (tiles done, tiles total).
   std::function<void(std::size_t, std::size_t)> progress;
+  // Called (serialised with `progress`, from the worker that finished the tile) after each rendered
+  // tile with its index in tileRegions(region, tileSize) and the film, whose pixels inside that
+  // tile are final (no grid overlay yet). Checkpointing hooks here.
+  std::function<void(std::size_t, const Film&)> tileFinished;
+  // Resume: when both are set, every tile i with (*resumeTiles)[i] true is copied from *resumeFilm
+  // (which must cover the same region) instead of rendered. Same scene and options as the earlier
+  // run give the same bytes as an uninterrupted render.
+  const Film* resumeFilm = nullptr;
+  const std::vector<bool>* resumeTiles = nullptr;
 };
+
+// The tiles a render of `region` is cut into, in the order render() numbers them: row-major from
+// the region's top-left corner, tileSize × tileSize pixels, clipped at the right and bottom edges.
+std::vector<PixelRegion> tileRegions(const PixelRegion& region, int tileSize);
 
 // Renders the scene (or its crop region) and applies the grid overlay. When cancelled, returns the
 // partial film with stats.cancelled = true.

@@ -36,6 +36,11 @@ LightSample illuminate(const Light& light, const Point3& p) {
           sample.toPoint = l.direction;
           sample.distance = kInfinity;
           sample.intensity = l.intensity;
+        } else if constexpr (std::is_same_v<T, AreaLight>) {
+          const Point3 centre =
+              l.shape == AreaShape::Rectangle ? l.corner + (l.edge1 + l.edge2) * 0.5 : l.center;
+          if (!towardPoint(centre, p, sample)) return sample;
+          sample.intensity = attenuate(l.intensity, l.attenuation, sample.distance);
         } else {
           if (!towardPoint(l.position, p, sample)) return sample;  // zero intensity
           sample.intensity = attenuate(l.intensity, l.attenuation, sample.distance);

@@ -38,7 +38,26 @@ struct SpotLight {
   double exponent = 1;
 };
 
-using Light = std::variant<DirectionalLight, PointLight, SpotLight>;
+// An area light (soft shadows): the shape's surface stands for `samples` point lights of intensity
+// I0 each, at stratified points over it; I_L(P) is their average, each attenuated by its own
+// distance and shadowed by its own shadow ray (kt product per sample). Invisible to camera rays,
+// like every glint light. Geometry in world space, with the keys of the object of that shape.
+enum class AreaShape { Rectangle, Disk, Sphere };
+
+struct AreaLight {
+  AreaShape shape = AreaShape::Rectangle;
+  Point3 corner;  // rectangle: one corner ...
+  Vec3 edge1;     //   ... and two perpendicular edges from it
+  Vec3 edge2;
+  Point3 center;      // disk, sphere
+  Vec3 normal;        // disk: unit normal (a disk light shines to both sides)
+  double radius = 0;  // disk, sphere
+  Color intensity;    // I0 = color × intensity, per point
+  Attenuation attenuation;
+  int samples = 16;  // shadow rays per shading point (≥ 1)
+};
+
+using Light = std::variant<DirectionalLight, PointLight, SpotLight, AreaLight>;
 
 // What a light delivers to a point P.
 struct LightSample {
@@ -48,7 +67,8 @@ struct LightSample {
 };
 
 // I_L(P) and l for any light (DESIGN.md §3). P at the position of a point/spot light gives zero
-// intensity (l is undefined there).
+// intensity (l is undefined there). An area light is treated here as one point light at its centre;
+// the renderer samples its surface instead.
 LightSample illuminate(const Light& light, const Point3& p);
 
 }  // namespace glint

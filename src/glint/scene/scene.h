@@ -25,12 +25,21 @@ struct GridOverlay {
   Color color;         // linear
 };
 
+// Adaptive anti-aliasing (image.adaptive; in the spirit of POV-Ray's adaptive mode): a pixel takes
+// ImageSettings::samples first and more, up to maxSamples, only while its samples disagree by more
+// than threshold (linear color units).
+struct AdaptiveSampling {
+  int maxSamples = 64;      // per pixel, ≥ ImageSettings::samples
+  double threshold = 0.05;  // > 0
+};
+
 struct ImageSettings {
   int width = 1;  // pixels (also given to the camera)
   int height = 1;
-  int samples = 1;  // per pixel, stratified
+  int samples = 1;  // per pixel, stratified; with `adaptive`, the minimum per pixel
   Encoding encoding = Encoding::Srgb;
   std::optional<GridOverlay> grid;
+  std::optional<AdaptiveSampling> adaptive;
 };
 
 struct RenderSettings {
