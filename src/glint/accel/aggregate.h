@@ -19,12 +19,17 @@ namespace glint {
 inline constexpr std::uint32_t kNoMesh = 0xffffffffu;
 
 struct Hit {
-  double t = 0;                  // ray parameter
-  Normal3 normal;                // unit geometric world-space normal, as the shape defines it
-  Normal3 shadingNormal;         // unit; interpolated vertex normal on smooth meshes, else = normal
+  double t = 0;           // ray parameter
+  Normal3 normal;         // unit geometric world-space normal, as the shape defines it
+  Normal3 shadingNormal;  // unit; interpolated vertex normal on smooth meshes, else = normal
+  // The hit point reprojected onto the surface and its per-coordinate error bound (world space,
+  // scene units): the exact surface passes through point ± pointError. Secondary rays start from
+  // spawnRay(point, pointError, normal, w) (core/spawn.h), not from ray.at(t).
+  Point3 point;
+  Vec3 pointError;
   std::uint32_t primitive = 0;   // index into the primitives, when mesh == kNoMesh
   std::uint32_t mesh = kNoMesh;  // index into the meshes, or kNoMesh for an analytic primitive
-  std::uint32_t triangle = 0;    // triangle index within the mesh
+  std::uint32_t triangle = 0;    // triangle index within meshes()[mesh] (see meshes())
 };
 
 // How the Aggregate organises its primitives: a BVH, or none (every ray tests every primitive —
@@ -54,6 +59,9 @@ class Aggregate {
   Color transmittance(const Ray& ray, double tMin, double tMax) const;
 
   const std::vector<Primitive>& primitives() const { return primitives_; }
+  // The meshes as stored. With Acceleration::Bvh each mesh's triangles and vertices are renumbered
+  // into the tree's leaf order and its degenerate triangles and unused vertices are left out (same
+  // values, same winding, same material); Hit::triangle indexes these, not the input order.
   const std::vector<TriangleMesh>& meshes() const { return meshes_; }
   Bounds3 bounds() const { return bounds_; }  // of the bounded primitives and the mesh triangles
   Acceleration acceleration() const { return acceleration_; }
@@ -68,6 +76,7 @@ class Aggregate {
   Color transmittanceBruteForce(const Ray& ray, double tMin, double tMax) const;
   void finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle, const WatertightHit& candidate,
                          Hit& hit) const;
+  void storeInLeafOrder(const std::vector<bvh::BuildItem>& items);
   friend struct AggregateInspector;  // aggregate_test.cpp checks the node layout invariants
 
   std::vector<Primitive> primitives_;
@@ -75,8 +84,9 @@ class Aggregate {
   std::vector<TriangleMesh> meshes_;
   std::vector<Color> meshTransmission_;
   std::vector<std::uint32_t> unbounded_;  // primitives tested on every ray (Bvh only)
-  // Bvh: the 4-wide tree; leaves point into leafRefs_, which holds primitive indices or triangle
-  // indices within the leaf's mesh, in leaf order.
+  // Bvh: the 4-wide tree. A primitive leaf points into leafRefs_ (primitive indices in leaf
+  // order); a triangle leaf holds a range of its mesh's triangles, which the build renumbers into
+  // leaf order (BruteForce: leafRefs_ holds the triangles of every mesh, see meshBegin_).
   std::vector<bvh::Node> nodes_;
   std::vector<std::uint32_t> leafRefs_;
   std::uint32_t rootChild_ = 0;

@@ -56,9 +56,24 @@ struct AggregateInspector {
       }
     }
     EXPECT_EQ(a.unbounded_, unbounded);
-    EXPECT_EQ(a.leafRefs_.size(), boundedCount + a.triangleCount());
+    EXPECT_EQ(a.leafRefs_.size(), boundedCount);
+    // Every mesh holds exactly its tree triangles, renumbered into leaf order, and only the
+    // vertices they use, numbered by first use.
+    std::size_t meshTriangles = 0;
+    for (const TriangleMesh& mesh : a.meshes_) {
+      meshTriangles += mesh.triangleCount();
+      std::uint32_t nextVertex = 0;
+      for (const std::uint32_t v : mesh.indices) {
+        EXPECT_LE(v, nextVertex) << "vertices numbered by first use";
+        if (v == nextVertex) ++nextVertex;
+      }
+      EXPECT_EQ(nextVertex, mesh.positions.size());
+      EXPECT_TRUE(mesh.normals.empty() || mesh.normals.size() == mesh.positions.size());
+    }
+    EXPECT_EQ(meshTriangles, a.triangleCount());
     if (a.rootInfo_ == bvh::kEmpty) {
       EXPECT_EQ(a.leafRefs_.size(), 0u);
+      EXPECT_EQ(meshTriangles, 0u);
       EXPECT_TRUE(a.nodes_.empty());
       return summary;
     }
@@ -92,9 +107,7 @@ struct AggregateInspector {
             b = prims[a.leafRefs_[k]].bounds();
           } else {
             const TriangleMesh& mesh = a.meshes_[leaf.key];
-            for (int v = 0; v < 3; ++v) {
-              b = unite(b, mesh.positions[mesh.indices[3 * a.leafRefs_[k] + v]]);
-            }
+            for (int v = 0; v < 3; ++v) b = unite(b, mesh.positions[mesh.indices[3 * k + v]]);
           }
           everything = unite(everything, b);
           EXPECT_TRUE(contains(item.lo.data(), item.hi.data(), b)) << "leaf box too small";
@@ -131,29 +144,32 @@ struct AggregateInspector {
     EXPECT_TRUE(std::all_of(visits.begin(), visits.end(), [](int v) { return v == 1; }))
         << "every node reached exactly once";
     EXPECT_LE(summary.maxDepth, bvh::kMaxDepth);
-    // Leaves tile the reference array, and every reference appears once per key.
-    std::sort(leaves.begin(), leaves.end(),
-              [](const Leaf& x, const Leaf& y) { return x.first < y.first; });
-    std::uint32_t next = 0;
+    // The primitive leaves tile the reference array, each primitive once; each mesh's leaves tile
+    // its triangles in order.
+    std::sort(leaves.begin(), leaves.end(), [](const Leaf& x, const Leaf& y) {
+      return std::pair(x.key, x.first) < std::pair(y.key, y.first);
+    });
+    std::vector<std::uint32_t> next(a.meshes_.size() + 1, 0);
+    const auto nextOf = [&](std::uint32_t key) -> std::uint32_t& {
+      return key == bvh::kPrimitiveKey ? next.back() : next[key];
+    };
     std::vector<std::uint32_t> primitivesSeen;
-    std::vector<std::vector<std::uint32_t>> trianglesSeen(a.meshes_.size());
     for (const Leaf& leaf : leaves) {
-      EXPECT_EQ(leaf.first, next);
-      next = leaf.first + leaf.count;
-      for (std::uint32_t k = leaf.first; k < next; ++k) {
-        (leaf.key == bvh::kPrimitiveKey ? primitivesSeen : trianglesSeen[leaf.key])
-            .push_back(a.leafRefs_[k]);
+      EXPECT_EQ(leaf.first, nextOf(leaf.key));
+      nextOf(leaf.key) = leaf.first + leaf.count;
+      if (leaf.key != bvh::kPrimitiveKey) continue;
+      for (std::uint32_t k = leaf.first; k < leaf.first + leaf.count; ++k) {
+        primitivesSeen.push_back(a.leafRefs_[k]);
       }
     }
-    EXPECT_EQ(next, a.leafRefs_.size());
+    EXPECT_EQ(next.back(), a.leafRefs_.size());
+    for (std::size_t m = 0; m < a.meshes_.size(); ++m) {
+      EXPECT_EQ(next[m], a.meshes_[m].triangleCount());
+    }
     std::sort(primitivesSeen.begin(), primitivesSeen.end());
     EXPECT_TRUE(std::adjacent_find(primitivesSeen.begin(), primitivesSeen.end()) ==
                 primitivesSeen.end());
     EXPECT_EQ(primitivesSeen.size(), boundedCount);
-    for (auto& seen : trianglesSeen) {
-      std::sort(seen.begin(), seen.end());
-      EXPECT_TRUE(std::adjacent_find(seen.begin(), seen.end()) == seen.end());
-    }
     summary.leaves = leaves.size();
     return summary;
   }
@@ -634,6 +650,30 @@ TriangleMesh torus(const Point3& center, double R, double r, int nu, int nv, boo
   return mesh;
 }
 
+// A flat sheet over [0, n]² in the plane z = 0: n × n unit cells, each split into two triangles
+// along alternating diagonals (so interior vertices are shared by fans of 4 or 8 triangles), with
+// alternating windings in every other row (so shared edges are traversed both ways and the same
+// way round).
+TriangleMesh sheet(int n) {
+  TriangleMesh mesh;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) mesh.positions.push_back({double(i), double(j), 0});
+  }
+  const auto at = [&](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      std::array<std::uint32_t, 6> t =
+          (i + j) % 2 == 0 ? std::array{at(i, j), at(i + 1, j),     at(i + 1, j + 1),
+                                        at(i, j), at(i + 1, j + 1), at(i, j + 1)}
+                           : std::array{at(i, j),     at(i + 1, j),     at(i, j + 1),
+                                        at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)};
+      if (j % 2 == 1) std::swap(t[1], t[2]);
+      mesh.indices.insert(mesh.indices.end(), t.begin(), t.end());
+    }
+  }
+  return mesh;
+}
+
 // Random triangles in [−kHalf, kHalf]³, with exact duplicates, a pair sharing an edge, and three
 // degenerate triangles (collinear, a repeated vertex, a non-finite vertex) that must never hit.
 TriangleMesh triangleSoup(Rng& rng, int count) {
@@ -742,11 +782,22 @@ std::vector<Query> meshQueries(const MeshScene& s, std::uint64_t seed, int count
   return queries;
 }
 
-// The same element at the same t, or a tie (another element hitting at exactly the same t).
-bool sameHit(const Aggregate& a, const Hit& x, const Hit& y, const Query& q) {
+// The vertices of a hit triangle, in index order.
+std::array<Point3, 3> hitTriangleVertices(const Aggregate& a, const Hit& h) {
+  const TriangleMesh& mesh = a.meshes()[h.mesh];
+  const std::uint32_t* v = &mesh.indices[3 * static_cast<std::size_t>(h.triangle)];
+  return {mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]]};
+}
+
+// The same element at the same t, or a tie (another element hitting at exactly the same t). x is
+// the BVH's answer, y brute force's; the BVH renumbers mesh triangles, so triangles are compared by
+// their vertices.
+bool sameHit(const Aggregate& a, const Aggregate& brute, const Hit& x, const Hit& y,
+             const Query& q) {
   if (x.t != y.t) return false;
   if (x.mesh == y.mesh &&
-      (x.mesh == kNoMesh ? x.primitive == y.primitive : x.triangle == y.triangle)) {
+      (x.mesh == kNoMesh ? x.primitive == y.primitive
+                         : hitTriangleVertices(a, x) == hitTriangleVertices(brute, y))) {
     return x.normal == y.normal && x.shadingNormal == y.shadingNormal;
   }
   // A tie: the element the BVH reports must hit at exactly that t.
@@ -777,7 +828,7 @@ Agreement compareWithBruteForce(const Aggregate& bvh, const Aggregate& brute,
     Hit actual;
     const bool e = brute.intersect(q.ray, q.tMin, q.tMax, expected);
     const bool a = bvh.intersect(q.ray, q.tMin, q.tMax, actual);
-    bool ok = e == a && (!e || sameHit(bvh, actual, expected, q));
+    bool ok = e == a && (!e || sameHit(bvh, brute, actual, expected, q));
     const Color expectedT = brute.transmittance(q.ray, q.tMin, q.tMax);
     ok = ok && expectedT == bvh.transmittance(q.ray, q.tMin, q.tMax);
     if (!ok && ++result.mismatches <= 8) {
@@ -919,6 +970,9 @@ TEST(AggregateMeshTest, ShadingNormalInterpolatesVertexNormals) {
   const Point3 c{0, 0, 0};
   const TriangleMesh smooth = uvSphere(c, 1.5, 8, 12, true);
   const Aggregate a({}, {}, {smooth}, {Color(0)});
+  // The aggregate keeps every vertex and triangle (none is degenerate), renumbered.
+  ASSERT_EQ(a.meshes()[0].positions.size(), smooth.positions.size());
+  ASSERT_EQ(a.meshes()[0].triangleCount(), smooth.triangleCount());
   // Aimed at a vertex along its normal: the shading normal is that vertex's normal, and unit.
   for (std::size_t v = 0; v < smooth.positions.size(); ++v) {
     const Vec3 n = toVec(smooth.normals[v]);
@@ -927,16 +981,20 @@ TEST(AggregateMeshTest, ShadingNormalInterpolatesVertexNormals) {
     ASSERT_TRUE(a.intersect(ray, 0, kInfinity, hit));
     EXPECT_NEAR(hit.t, 4, 1e-12);
     EXPECT_EQ(hit.mesh, 0u);
-    const std::uint32_t* tri = &smooth.indices[3 * hit.triangle];
-    EXPECT_TRUE(tri[0] == v || tri[1] == v || tri[2] == v) << "the hit triangle holds the vertex";
+    const TriangleMesh& stored = a.meshes()[0];
+    const std::uint32_t* tri = &stored.indices[3 * hit.triangle];
+    EXPECT_TRUE(stored.positions[tri[0]] == smooth.positions[v] ||
+                stored.positions[tri[1]] == smooth.positions[v] ||
+                stored.positions[tri[2]] == smooth.positions[v])
+        << "the hit triangle holds the vertex";
     EXPECT_NEAR(hit.shadingNormal.x, n.x, 1e-12);
     EXPECT_NEAR(hit.shadingNormal.y, n.y, 1e-12);
     EXPECT_NEAR(hit.shadingNormal.z, n.z, 1e-12);
     EXPECT_NEAR(length(hit.shadingNormal), 1, 1e-15);
     // The geometric normal is the triangle's, by the right-hand rule over its index order.
-    const Point3& p0 = smooth.positions[tri[0]];
+    const Point3& p0 = stored.positions[tri[0]];
     const Vec3 geometric =
-        normalize(cross(smooth.positions[tri[1]] - p0, smooth.positions[tri[2]] - p0));
+        normalize(cross(stored.positions[tri[1]] - p0, stored.positions[tri[2]] - p0));
     EXPECT_EQ(toVec(hit.normal), geometric);
     EXPECT_GT(dot(hit.normal, n), 0.8);
   }
@@ -982,7 +1040,9 @@ TEST(AggregateMeshTest, DegenerateTrianglesNeverHit) {
       }
     }
     ASSERT_TRUE(a.intersect({{0.2, 0.2, 0}, {0, 0, 1}}, 0, kInfinity, hit));
-    EXPECT_EQ(hit.triangle, 4u);
+    // Brute force keeps the input numbering; the BVH keeps only the proper triangle, renumbered.
+    EXPECT_EQ(hit.triangle, acceleration == Acceleration::Bvh ? 0u : 4u);
+    EXPECT_EQ(a.meshes()[0].triangleCount(), acceleration == Acceleration::Bvh ? 1u : 5u);
     EXPECT_EQ(hit.t, 5);
   }
   // Nothing but degenerate triangles: an empty structure.
@@ -1036,6 +1096,71 @@ TEST(AggregateMeshTest, MeshTransmissionCountsEveryCrossing) {
   // An opaque mesh blacks the shadow ray out.
   const Aggregate opaque({}, {}, {square, far}, {Color(0.5), Color(0)});
   EXPECT_EQ(opaque.transmittance(ray, 0, kInfinity), Color(0));
+}
+
+// A shadow ray through an edge shared by two triangles, or through a vertex shared by a fan,
+// crosses the surface once: kt is applied once, by the BVH and by brute force alike (issue 6: no
+// ray passes between two triangles sharing an edge, and none is counted twice). Vertical rays hit
+// the sheet's edges and vertices exactly (every edge function is exactly 0 there); oblique ones
+// nearly.
+TEST(AggregateMeshTest, ShadowRayThroughASharedEdgeOrVertexCrossesOnce) {
+  const int n = 4;
+  const TriangleMesh mesh = sheet(n);
+  const std::array<Vec3, 6> directions{Vec3{0, 0, -1},     Vec3{0, 0, 1},      Vec3{0.3, -0.2, -1},
+                                       Vec3{-1, 0.5, 0.7}, Vec3{0.1, 1, -0.4}, Vec3{1, 1, -1}};
+  for (const Acceleration acceleration : {Acceleration::Bvh, Acceleration::BruteForce}) {
+    const Aggregate a({}, {}, {mesh}, {Color(0.5)}, acceleration);
+    int rays = 0;
+    int wrong = 0;
+    // Every vertex, edge midpoint, diagonal point and cell centre strictly inside the sheet.
+    for (int yi = 1; yi < 4 * n; ++yi) {
+      for (int xi = 1; xi < 4 * n; ++xi) {
+        const Point3 target{xi / 4.0, yi / 4.0, 0};
+        for (const Vec3& d : directions) {
+          const Ray ray{target - d * 3, d};
+          const Color t = a.transmittance(ray, 0, kInfinity);
+          Hit hit;
+          const bool hits = a.intersect(ray, 0, kInfinity, hit);
+          if (!(t == Color(0.5)) || !hits || std::abs(hit.t - 3) > 1e-12) {
+            if (++wrong <= 5) {
+              ADD_FAILURE() << "ray at (" << target.x << ", " << target.y << ") d=(" << d.x << ", "
+                            << d.y << ", " << d.z << "): transmittance " << t.r << ", hit " << hits;
+            }
+          }
+          ++rays;
+        }
+      }
+    }
+    EXPECT_EQ(wrong, 0) << "of " << rays;
+    // Along an interior edge (in the sheet's plane) the ray is parallel to it: no crossing.
+    EXPECT_EQ(a.transmittance({{1, -1, 0}, {0, 1, 0}}, 0, kInfinity), Color(1));
+  }
+}
+
+// Leaving a closed convex mesh through any of its vertices or edges crosses it exactly once.
+TEST(AggregateMeshTest, ShadowRayLeavingAClosedMeshThroughVerticesAndEdgesCrossesOnce) {
+  const Point3 c{0.25, -0.5, 0.125};
+  const TriangleMesh mesh = uvSphere(c, 2, 12, 24, false);
+  std::vector<Point3> targets = mesh.positions;
+  for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
+    for (int e = 0; e < 3; ++e) {
+      const Point3& p = mesh.positions[mesh.indices[3 * t + e]];
+      const Point3& q = mesh.positions[mesh.indices[3 * t + (e + 1) % 3]];
+      targets.push_back(p + (q - p) * 0.5);
+    }
+  }
+  for (const Acceleration acceleration : {Acceleration::Bvh, Acceleration::BruteForce}) {
+    const Aggregate a({}, {}, {mesh}, {Color(0.5)}, acceleration);
+    Rng rng(11);
+    int wrong = 0;
+    for (const Point3& target : targets) {
+      const Point3 from = c + uniformDirection(rng) * (1.5 * rng.uniform());
+      if (!(a.transmittance({from, target - from}, 0, kInfinity) == Color(0.5))) ++wrong;
+      // Along the centre's axis too: through the pole fans and ring vertices head-on.
+      if (!(a.transmittance({c, target - c}, 0, kInfinity) == Color(0.5))) ++wrong;
+    }
+    EXPECT_EQ(wrong, 0) << "of " << 2 * targets.size() << " rays";
+  }
 }
 
 TEST(AggregateMeshTest, ParallelBuildIsIndependentOfTheThreadCount) {

@@ -29,6 +29,11 @@ class ShapeError : public std::invalid_argument {
 struct ShapeHit {
   double t = 0;    // ray parameter of the hit, tMin < t < tMax
   Normal3 normal;  // unit geometric normal as the shape defines it (never flipped toward the ray)
+  // The hit point, reprojected onto the surface (not ray.at(t), whose error grows with the ray's
+  // origin and length), and a per-coordinate bound on its rounding error: the exact surface passes
+  // through the box point ± pointError. Both in the space of the ray. For spawnRay (core/spawn.h).
+  Point3 point;
+  Vec3 pointError;
 };
 
 // Conventions shared by every shape below:

@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "glint/core/spawn.h"
 #include "glint/geometry/shape.h"
 #include "glint/geometry/watertight_triangle.h"
 
@@ -138,6 +139,51 @@ bool planeParameter(const Point3& point, const Normal3& n, const Ray& ray, doubl
 
 bool inOpenRange(double t, double tMin, double tMax) { return t > tMin && t < tMax; }
 
+// --- hit points with error bounds (core/spawn.h states the policy these serve) ---
+// Each bound covers the rounding of the reprojected point itself and the error with which the
+// intersection routine of the same shape, run again from a point near it, decides which side of
+// the surface that point is on; both involve the same magnitudes, named in each bound.
+
+Vec3 uniform(double e) { return Vec3{e, e, e}; }
+
+// ray.at(t) moved onto the plane through q with unit normal n, along n. The distance s = n·(p − q)
+// is computed with error γ4·|n|₁·|p − q|∞ and the move adds rounding of |p|; the plane
+// intersection routine decides the side of a point from n·(q − o) with the same error. `scale`
+// adds magnitudes the routine also subtracts (a cylinder's height for its top cap).
+void planeHitPoint(const Ray& ray, double t, const Point3& q, const Normal3& n, double scale,
+                   ShapeHit& hit) {
+  const Point3 p = ray.at(t);
+  const Point3 onPlane = p - toVec(n) * dot(n, p - q);
+  hit.point = onPlane;
+  hit.pointError = abs(toVec(onPlane)) * gammaBound(3) +
+                   uniform(gammaBound(10) * (maxComponent(abs(onPlane - q)) + scale));
+}
+
+// A point `rel` (relative to axisPoint, near the tube of radius r around the unit axis) moved
+// radially onto the tube. Splitting rel into its axial and radial parts and rescaling the radial
+// part costs a few ulps of |rel| and r; adding axisPoint back rounds at |point|.
+void tubeHitPoint(const Point3& axisPoint, const Vec3& axis, double r, const Vec3& rel,
+                  ShapeHit& hit) {
+  const double h = dot(rel, axis);
+  const Vec3 radial = rel - axis * h;
+  const Vec3 onSurface = axis * h + radial * (r / length(radial));
+  hit.point = axisPoint + onSurface;
+  hit.pointError = abs(toVec(hit.point)) * gammaBound(3) +
+                   uniform(gammaBound(32) * (maxComponent(abs(onSurface)) + r));
+}
+
+// The hit on the box face of `axis` at coordinate `face`: that coordinate is snapped exactly, so
+// the error across the face is 0 (the slab test subtracts it from a spawned origin exactly, by
+// Sterbenz's lemma); the other two coordinates keep the rounding of ray.at(t).
+void boxHitPoint(const Ray& ray, double t, int axis, double face, ShapeHit& hit) {
+  Point3 p = ray.at(t);
+  p[axis] = face;
+  hit.point = p;
+  Vec3 e = (abs(toVec(ray.origin)) + abs(ray.direction * t)) * gammaBound(3);
+  e[axis] = 0;
+  hit.pointError = e;
+}
+
 // Roots t0 < t1 of |f + t·d|² = r² (f = origin relative to the centre, d the direction; both
 // already projected onto the cross-section for tubes), by the method of Ray Tracing Gems ch. 7
 // ("Precision Improvements for Ray/Sphere Intersection", Haines et al. 2019): the discriminant from
@@ -222,7 +268,13 @@ bool Sphere::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) 
     return false;
   }
   hit.t = t;
-  hit.normal = Normal3(normalize(f + ray.direction * t));
+  const Vec3 rel = f + ray.direction * t;
+  hit.normal = Normal3(normalize(rel));
+  // Radial reprojection onto the sphere (error γ5·|rel|, pbrt-v4 §6.8.5); the re-intersection
+  // test |o − c|² − r² of a spawned origin o is exact to a few ulps of r² and r·|o − c|.
+  const Vec3 onSphere = rel * (radius / length(rel));
+  hit.point = center + onSphere;
+  hit.pointError = abs(onSphere) * gammaBound(8) + abs(toVec(hit.point)) * gammaBound(2);
   return true;
 }
 
@@ -256,6 +308,7 @@ bool Plane::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) c
   if (!planeParameter(point, normal, ray, t) || !inOpenRange(t, tMin, tMax)) return false;
   hit.t = t;
   hit.normal = normal;
+  planeHitPoint(ray, t, point, normal, 0, hit);
   return true;
 }
 
@@ -284,6 +337,7 @@ bool Triangle::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit
   }
   hit.t = candidate.t;
   hit.normal = normal;
+  watertightHitPoint(v0, v1, v2, candidate, hit.point, hit.pointError);
   return true;
 }
 
@@ -337,6 +391,7 @@ bool Polygon::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit)
   }
   hit.t = t;
   hit.normal = normal;
+  planeHitPoint(ray, t, vertices[0], normal, 0, hit);
   return true;
 }
 
@@ -379,6 +434,7 @@ bool Rectangle::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hi
   if (!(s >= 0 && s <= 1 && r >= 0 && r <= 1)) return false;
   hit.t = t;
   hit.normal = normal;
+  planeHitPoint(ray, t, corner, normal, 0, hit);
   return true;
 }
 
@@ -443,10 +499,16 @@ bool Quadrangle::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& h
   };
   WatertightHit candidate;
   bool found = half(corners[0], corners[1], corners[2], tMax, candidate);
-  if (half(corners[0], corners[2], corners[3], found ? candidate.t : tMax, candidate)) found = true;
+  bool second = false;
+  if (half(corners[0], corners[2], corners[3], found ? candidate.t : tMax, candidate)) {
+    found = true;
+    second = true;
+  }
   if (!found) return false;
   hit.t = candidate.t;
   hit.normal = normal;
+  watertightHitPoint(corners[0], second ? corners[2] : corners[1], second ? corners[3] : corners[2],
+                     candidate, hit.point, hit.pointError);
   return true;
 }
 
@@ -484,6 +546,7 @@ bool Tube::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) co
   }
   hit.t = t;
   hit.normal = radialNormal(f + ray.direction * t, axis);
+  tubeHitPoint(origin, axis, radius, f + ray.direction * t, hit);
   return true;
 }
 
@@ -581,12 +644,15 @@ bool Cylinder::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit
   switch (part) {
     case CylinderPart::kSide:
       hit.normal = radialNormal(ray.origin - base + ray.direction * hit.t, axis);
+      tubeHitPoint(base, axis, radius, ray.origin - base + ray.direction * hit.t, hit);
       break;
     case CylinderPart::kBase:
       hit.normal = Normal3(-axis);
+      planeHitPoint(ray, hit.t, base, hit.normal, 0, hit);
       break;
     case CylinderPart::kTop:
       hit.normal = Normal3(axis);
+      planeHitPoint(ray, hit.t, base + axis * height, hit.normal, height, hit);
       break;
   }
   return true;
@@ -676,12 +742,16 @@ bool Box::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) con
   if (!boxSlabs(*this, ray, s)) return false;
   if (inOpenRange(s.tEnter, tMin, tMax)) {
     hit.t = s.tEnter;  // the entered face faces against the ray
-    hit.normal = axisNormal(s.enterAxis, ray.direction[s.enterAxis] > 0 ? -1.0 : 1.0);
+    const bool positive = ray.direction[s.enterAxis] < 0;
+    hit.normal = axisNormal(s.enterAxis, positive ? 1.0 : -1.0);
+    boxHitPoint(ray, hit.t, s.enterAxis, positive ? hi[s.enterAxis] : lo[s.enterAxis], hit);
     return true;
   }
   if (inOpenRange(s.tExit, tMin, tMax)) {
     hit.t = s.tExit;  // from inside: the exit face, still with its outward normal
-    hit.normal = axisNormal(s.exitAxis, ray.direction[s.exitAxis] > 0 ? 1.0 : -1.0);
+    const bool positive = ray.direction[s.exitAxis] > 0;
+    hit.normal = axisNormal(s.exitAxis, positive ? 1.0 : -1.0);
+    boxHitPoint(ray, hit.t, s.exitAxis, positive ? hi[s.exitAxis] : lo[s.exitAxis], hit);
     return true;
   }
   return false;
@@ -731,6 +801,7 @@ bool Disk::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) co
   if (distanceSquared(ray.at(t), center) > radius * radius) return false;
   hit.t = t;
   hit.normal = normal;
+  planeHitPoint(ray, t, center, normal, 0, hit);
   return true;
 }
 
@@ -764,6 +835,36 @@ void requireInvertibleAffine(const Transform& transform) {
                      m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
   if (det == 0 || !std::isfinite(det))
     throw ShapeError(fmt::format("transform must be invertible, got determinant {}", det));
+}
+
+// Error bound of worldFromObject(p) for an object-space point p with error bound e (pbrt-v4
+// §6.8.6: (1 + γ3)·|M|·e + γ3·(|M|·|p| + |translation|)), plus the round trip: a ray spawned near
+// the world point is mapped back by the stored inverse, whose rounding (γ3 of |M⁻¹|·|o|) and
+// inexactness as an inverse, carried back to world space, grow with the condition number
+// κ = ‖|M|·|M⁻¹|‖∞ of the linear part (1 for scales, ≤ 3 for rotations).
+Vec3 worldPointError(const Transform& worldFromObject, const Point3& p, const Vec3& e,
+                     const Point3& world) {
+  const auto& m = worldFromObject.matrix().m;
+  const auto& inv = worldFromObject.inverseMatrix().m;
+  double kappa = 0;
+  double translation = 0;
+  for (int i = 0; i < 3; ++i) {
+    double row = 0;
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) row += std::abs(m[i][k]) * std::abs(inv[k][j]);
+    kappa = std::max(kappa, row);
+    translation = std::max(translation, std::abs(m[i][3]));
+  }
+  const double roundTrip = gammaBound(8) * kappa * (maxComponent(abs(toVec(world))) + translation);
+  Vec3 out;
+  for (int i = 0; i < 3; ++i) {
+    const double carried =
+        std::abs(m[i][0]) * e.x + std::abs(m[i][1]) * e.y + std::abs(m[i][2]) * e.z;
+    const double rounding = std::abs(m[i][0] * p.x) + std::abs(m[i][1] * p.y) +
+                            std::abs(m[i][2] * p.z) + std::abs(m[i][3]);
+    out[i] = (1 + gammaBound(3)) * carried + gammaBound(3) * rounding + roundTrip;
+  }
+  return out;
 }
 
 // objectFromWorld applied to a ray: the inverse matrix of worldFromObject, with the same arithmetic
@@ -804,6 +905,9 @@ bool Primitive::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hi
   if (!std::visit([&](const auto& s) { return s.intersect(objectRay, tMin, tMax, hit); }, shape_))
     return false;
   hit.normal = normalize((*worldFromObject_)(hit.normal));
+  const Point3 objectPoint = hit.point;
+  hit.point = (*worldFromObject_)(objectPoint);
+  hit.pointError = worldPointError(*worldFromObject_, objectPoint, hit.pointError, hit.point);
   return true;
 }
 

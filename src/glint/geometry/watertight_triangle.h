@@ -2,6 +2,7 @@
 // the analytic Triangle/Quadrangle shapes and the mesh triangles of the acceleration structure.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -9,6 +10,7 @@
 #include <utility>
 
 #include "glint/core/ray.h"
+#include "glint/core/spawn.h"
 #include "glint/core/vec.h"
 
 namespace glint {
@@ -145,6 +147,29 @@ inline bool intersectWatertight(const WatertightRay& r, const Point3& p0, const 
   hit.w = w;
   hit.det = det;
   return true;
+}
+
+// The point of a watertight hit on the triangle p0 p1 p2, by barycentric interpolation
+// (u·p0 + v·p1 + w·p2) / det, and its per-coordinate error bound (pbrt-v4 §6.8.5): γ7·Σ|b_i·p_i|
+// for the interpolation (barycentrics that do not sum exactly to 1 scale the point about the
+// origin, which the same bound covers), plus γ16 × the triangle's extent around the point: a ray
+// spawned from it decides its side of the plane from vertex coordinates relative to its origin
+// (sheared as in intersectWatertight), with a rounding error of a few ulps of that extent.
+inline void watertightHitPoint(const Point3& p0, const Point3& p1, const Point3& p2,
+                               const WatertightHit& hit, Point3& point, Vec3& pointError) {
+  const double inverseDet = 1 / hit.det;
+  const double b0 = hit.u * inverseDet;
+  const double b1 = hit.v * inverseDet;
+  const double b2 = hit.w * inverseDet;
+  const Vec3 w0 = toVec(p0) * b0;
+  const Vec3 w1 = toVec(p1) * b1;
+  const Vec3 w2 = toVec(p2) * b2;
+  point = toPoint(w0 + w1 + w2);
+  const double extent = std::max({maxComponent(abs(p0 - point)), maxComponent(abs(p1 - point)),
+                                  maxComponent(abs(p2 - point))});
+  const double extentError = gammaBound(16) * extent;
+  pointError =
+      (abs(w0) + abs(w1) + abs(w2)) * gammaBound(7) + Vec3{extentError, extentError, extentError};
 }
 
 }  // namespace glint
