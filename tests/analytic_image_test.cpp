@@ -9,6 +9,7 @@
 // larger.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -464,16 +465,24 @@ TEST(AnalyticImage, SupersamplingKeepsTheMeanOfAUniformPlane) {
   const Vec3 l = normalize(Vec3{0.3, 0.2, -1});
   const Color expected = diffuse.kd * std::abs(l.z);
   for (const int samples : {1, 2, 4, 9}) {
-    SceneParts parts = baseParts(21, 21, 2, 2);
-    parts.primitives.emplace_back(Plane::make({0, 0, -10}, {0, 0, 1}), addMaterial(parts, diffuse),
-                                  Color{});
-    parts.lights.push_back(DirectionalLight{l, Color(1, 1, 1)});
-    parts.image.samples = samples;
-    const Film film = render(Scene(std::move(parts)));
-    Color mean;
-    for (const Color& c : film.pixels()) mean += c;
-    mean = mean / static_cast<double>(film.pixels().size());
-    EXPECT_TRUE(colorNear(mean, expected)) << samples << " samples";
+    for (const bool adaptive : {false, true}) {
+      SceneParts parts = baseParts(21, 21, 2, 2);
+      parts.primitives.emplace_back(Plane::make({0, 0, -10}, {0, 0, 1}),
+                                    addMaterial(parts, diffuse), Color{});
+      parts.lights.push_back(DirectionalLight{l, Color(1, 1, 1)});
+      parts.image.samples = samples;
+      if (adaptive) parts.image.adaptive = AdaptiveSampling{32, 1e-6};
+      RenderStats stats;
+      const Film film = render(Scene(std::move(parts)), {}, &stats);
+      Color mean;
+      for (const Color& c : film.pixels()) mean += c;
+      mean = mean / static_cast<double>(film.pixels().size());
+      EXPECT_TRUE(colorNear(mean, expected)) << samples << " samples, adaptive " << adaptive;
+      // Adaptive: every pixel's samples agree, so none takes more than the initial count (at
+      // least 4).
+      const auto perPixel = static_cast<std::uint64_t>(adaptive ? std::max(samples, 4) : samples);
+      EXPECT_EQ(stats.rays.camera, 21u * 21u * perPixel) << samples << ", adaptive " << adaptive;
+    }
   }
 }
 

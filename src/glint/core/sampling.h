@@ -1,6 +1,8 @@
-// Sample patterns and warps: stratified 2D points and uniform directions in a cone.
+// Sample patterns and warps: stratified 2D points, uniform directions in a cone or on the sphere,
+// uniform points on the disk. The sample points themselves come from core/sampler.h.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -38,15 +40,30 @@ inline Point2 stratified2D(std::uint32_t k, std::uint32_t n, double jitterX, dou
 }
 
 // Direction uniformly distributed over the spherical cap of half-angle acos(cosMax) around the unit
-// vector `axis`; u in [0,1)² (pbrt's UniformSampleCone).
-inline Vec3 sampleCone(const Vec3& axis, double cosMax, const Point2& u) {
+// vector `axis`, whose orthonormal basis (t, b) orthonormalBasis gives; u in [0,1)² (pbrt's
+// UniformSampleCone). Loops over one cone compute the basis once.
+inline Vec3 sampleCone(const Vec3& axis, const Vec3& t, const Vec3& b, double cosMax,
+                       const Point2& u) {
   const double cosTheta = 1 - u.x * (1 - cosMax);
   const double sinTheta = std::sqrt(std::max(0.0, 1 - cosTheta * cosTheta));
   const double phi = 2 * std::numbers::pi * u.y;
+  return t * (std::cos(phi) * sinTheta) + b * (std::sin(phi) * sinTheta) + axis * cosTheta;
+}
+
+inline Vec3 sampleCone(const Vec3& axis, double cosMax, const Point2& u) {
   Vec3 t;
   Vec3 b;
   orthonormalBasis(axis, t, b);
-  return t * (std::cos(phi) * sinTheta) + b * (std::sin(phi) * sinTheta) + axis * cosTheta;
+  return sampleCone(axis, t, b, cosMax, u);
+}
+
+// Direction uniformly distributed over the unit sphere (Archimedes: z uniform in [−1, 1]); u in
+// [0,1)².
+inline Vec3 sampleUniformSphere(const Point2& u) {
+  const double z = 1 - 2 * u.x;
+  const double r = std::sqrt(std::max(0.0, 1 - z * z));
+  const double phi = 2 * std::numbers::pi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
 // Point uniformly distributed on the unit disk (Shirley–Chiu concentric mapping); u in [0,1)².

@@ -1,4 +1,6 @@
-// The Whitted/Phong integrator of DESIGN.md §3 and the tile scheduler that drives it.
+// The Whitted/Phong integrator of DESIGN.md §3 with distributed ray tracing (sampler-driven pixel,
+// lens, glossy and area-light samples; adaptive anti-aliasing) and the tile scheduler that drives
+// it.
 #include "glint/render/renderer.h"
 
 #include <tbb/blocked_range.h>
@@ -16,17 +18,42 @@
 #include <string>
 #include <variant>
 
+#include "glint/core/sampler.h"
 #include "glint/core/sampling.h"
 #include "glint/core/spawn.h"
 
 namespace glint {
 namespace {
 
-// Per-sample state shared by every ray of one camera path tree. Lives on the stack of the pixel
+// Sample dimension layout (core/sampler.h: each dimension is an independent 2D scrambled Sobol
+// sequence, selected by a SampleStream key and this number). The stream of camera sample s of a
+// pixel (sequence index s):
+//   0      pixel offset inside the pixel (only with several samples or adaptive sampling; one
+//          fixed sample goes through the pixel centre, DESIGN.md §4)
+//   1      lens point for the thin lens (depth of field; unused by a pinhole camera)
+// At every surface hit, on the stream of the path that reached it:
+//   2      reflection lobe: glossy cone direction(s)
+//   3      refraction lobe: the same for the transmitted direction(s)
+//   4 + i  area light i (its index in Scene::lights()): the points sampled on its surface
+// The primary hit shares the camera sample's stream (its dimensions start at 2). A secondary ray
+// continues on stream.branch(lobe dimension, count, k): a new key, so the next hit draws its own
+// dimensions 2, 3, 4 + i independently of this hit's; fanned-out sub-samples (glossy rays, area
+// light points) take consecutive sequence indices index·count + k, so they stratify against each
+// other and against the other pixel samples.
+constexpr std::uint32_t kPixelDimension = 0;
+constexpr std::uint32_t kLensDimension = 1;
+constexpr std::uint32_t kReflectionDimension = 2;
+constexpr std::uint32_t kRefractionDimension = 3;
+constexpr std::uint32_t kFirstLightDimension = 4;
+
+// Adaptive anti-aliasing starts with at least this many samples per pixel: fewer give no useful
+// estimate of the pixel's error (four Sobol points already fall one in each quadrant).
+constexpr std::uint32_t kMinAdaptiveSamples = 4;
+
+// Per-render state shared by every ray of one camera path tree. Lives on the stack of the pixel
 // loop; nothing here allocates.
 struct TraceContext {
   const Scene& scene;
-  Rng& rng;
   RayCounts& counts;
   int maxDepth;
   double minWeight;
@@ -35,7 +62,8 @@ struct TraceContext {
 
 enum class SecondaryKind { Reflection, Refraction };
 
-Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split);
+Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split,
+            const SampleStream& stream);
 
 // The position of a point or spot light; false for a directional light (at infinity).
 bool lightPosition(const Light& light, Point3& position) {
@@ -50,41 +78,97 @@ bool lightPosition(const Light& light, Point3& position) {
   return false;
 }
 
-// Direct lighting (DESIGN.md §3), n the geometric normal, v the unit view direction:
-//   Σ_lights [(n·l)(n·v) > 0] · T_L(P) · I_L(P) · (kd·|ns·l| + ks·max(0, −v·r)^shininess),
-// with the shading normal ns (= n except on smooth meshes) in the diffuse term and in r. The side
-// tests and the shadow ray's origin use the geometric n; a light on the other side of ns than of n
-// gives no diffuse term.
-Color directLight(const TraceContext& ctx, const Material& material, const Point3& p,
-                  const Normal3& n, const Normal3& ns, const Vec3& v) {
+// Shading inputs at one hit that every light sample shares (references into trace()'s frame: no
+// copies per hit).
+struct ShadingPoint {
+  const Material& material;
+  const Point3& p;     // on the surface (Hit::point)
+  const Vec3& pError;  // per-coordinate error bound of p (Hit::pointError), for spawnRay
+  const Normal3& n;    // geometric: side tests and shadow-ray origins
+  const Normal3& ns;   // shading (= n except on smooth meshes): diffuse term and mirror direction
+  const Vec3& v;       // unit view direction
+  double nv;           // n·v
+  bool hasSpecular;
+};
+
+// One light sample's term of DESIGN.md §3:
+//   [(n·l)(n·v) > 0] · T_L(P) · I_L(P) · (kd·|ns·l| + ks·max(0, −v·r)^shininess),
+// with its own shadow ray toward `lightPoint` (tMax = the distance to it, so nothing behind the
+// light, and never the light itself, blocks) or toward infinity when lightPoint is null.
+// Inlined: it runs once per light per hit, and an out-of-line call costs more than its shading.
+[[gnu::always_inline]] inline Color shadeLightSample(const TraceContext& ctx,
+                                                     const ShadingPoint& sp,
+                                                     const LightSample& sample,
+                                                     const Point3* lightPoint) {
+  const Vec3& l = sample.toPoint;
+  const double nl = dot(sp.n, l);
+  // The light and the eye must be on the same side of the surface.
+  if (!(nl * sp.nv > 0)) return Color();
+
+  const Ray shadowRay = spawnRay(sp.p, sp.pError, sp.n, -l);
+  const double tMax = lightPoint ? distance(shadowRay.origin, *lightPoint) : kInfinity;
+  ++ctx.counts.shadow;
+  const Color transmittance = ctx.scene.transmittance(shadowRay, tMax);
+  if (isBlack(transmittance)) return Color();
+
+  const Material& material = sp.material;
+  const double nsl = dot(sp.ns, l);
+  Color response = nsl * nl > 0 ? material.kd * std::abs(nsl) : Color();
+  if (sp.hasSpecular) {
+    const Vec3 r = l - toVec(sp.ns) * (2 * nsl);  // the light's mirror direction about ns
+    response += material.ks * std::pow(std::max(0.0, -dot(sp.v, r)), material.shininess);
+  }
+  return transmittance * sample.intensity * response;
+}
+
+// Area-light sample budget ("the per-hit ray count falls with depth"): a path that has not split
+// yet takes the light's `samples` points (shadow rays); a path below a glossy split (one of
+// blurSamples sibling rays) takes ⌈samples / blurSamples⌉, so the siblings together spend about
+// `samples` shadow rays per area light at each depth, as the one unsplit path would.
+std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSamples, bool split) {
+  const auto samples = static_cast<std::uint32_t>(std::max(light.samples, 1));
+  return split ? std::max<std::uint32_t>(1, (samples + blurSamples - 1) / blurSamples) : samples;
+}
+
+// Direct lighting (DESIGN.md §3) with the shading normal ns (= n except on smooth meshes) in the
+// diffuse term and in r. The side tests and the shadow ray's origin use the geometric n; a light on
+// the other side of ns than of n gives no diffuse term. An area light is the average of its
+// sample points, each a point light of I0 with its own distance falloff and shadow ray.
+// An area light's term: the average over its sample points, each a point light of I0 with its own
+// distance falloff and shadow ray. Kept out of line so that the loop over the other lights stays
+// small.
+[[gnu::noinline]] Color areaLightTerm(const TraceContext& ctx, const ShadingPoint& sp,
+                                      const AreaLight& area, std::uint32_t dimension,
+                                      const SampleStream& stream, bool split) {
+  const std::uint32_t count = areaLightSampleCount(area, ctx.blurSamples, split);
+  const SobolDimension2D points = stream.dimension(dimension);
+  Color sum;
+  for (std::uint32_t k = 0; k < count; ++k) {
+    const Point3 x = sampleAreaLight(area, sp.p, points.at(stream.subIndex(count, k)));
+    const LightSample sample = illuminateFrom(area, x, sp.p);
+    if (isBlack(sample.intensity)) continue;
+    sum += shadeLightSample(ctx, sp, sample, &x);
+  }
+  return sum / static_cast<double>(count);
+}
+
+Color directLight(const TraceContext& ctx, const ShadingPoint& sp, const SampleStream& stream,
+                  bool split) {
   Color sum;
   // Nothing for a light to act on: skip the shadow rays too.
-  const bool hasSpecular = !isBlack(material.ks);
-  if (isBlack(material.kd) && !hasSpecular) return sum;
-  const double nv = dot(n, v);
-  for (const Light& light : ctx.scene.lights()) {
-    const LightSample sample = illuminate(light, p);
-    if (isBlack(sample.intensity)) continue;
-    const Vec3& l = sample.toPoint;
-    const double nl = dot(n, l);
-    // The light and the eye must be on the same side of the surface.
-    if (!(nl * nv > 0)) continue;
-
-    const Ray shadowRay = spawnRay(p, n, -l);
-    Point3 position;
-    const double tMax =
-        lightPosition(light, position) ? distance(shadowRay.origin, position) : kInfinity;
-    ++ctx.counts.shadow;
-    const Color transmittance = ctx.scene.transmittance(shadowRay, tMax);
-    if (isBlack(transmittance)) continue;
-
-    const double nsl = dot(ns, l);
-    Color response = nsl * nl > 0 ? material.kd * std::abs(nsl) : Color();
-    if (hasSpecular) {
-      const Vec3 r = l - toVec(ns) * (2 * nsl);  // the light's mirror direction about ns
-      response += material.ks * std::pow(std::max(0.0, -dot(v, r)), material.shininess);
+  if (isBlack(sp.material.kd) && !sp.hasSpecular) return sum;
+  const std::vector<Light>& lights = ctx.scene.lights();
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    const Light& light = lights[i];
+    if (const auto* area = std::get_if<AreaLight>(&light)) {
+      sum += areaLightTerm(ctx, sp, *area, kFirstLightDimension + static_cast<std::uint32_t>(i),
+                           stream, split);
+      continue;
     }
-    sum += transmittance * sample.intensity * response;
+    const LightSample sample = illuminate(light, sp.p);
+    if (isBlack(sample.intensity)) continue;
+    Point3 position;
+    sum += shadeLightSample(ctx, sp, sample, lightPosition(light, position) ? &position : nullptr);
   }
   return sum;
 }
@@ -95,39 +179,46 @@ Color directLight(const TraceContext& ctx, const Material& material, const Point
 // would go through the surface to the other side than `ideal` dropped, the rest averaged.
 //
 // Ray budget ("per-hit ray count falls with depth"): the first glossy lobe on a path traces
-// blurSamples stratified rays; every ray below it is marked `split`, and a split path uses a single
-// jittered cone ray at later glossy bounces. So a path tree holds at most blurSamples rays per
-// glossy lobe of its first glossy hit instead of blurSamples^depth.
-Color traceLobe(const TraceContext& ctx, const Point3& p, const Normal3& n, const Vec3& ideal,
-                double blurDegrees, SecondaryKind kind, int depth, const Color& weight,
-                bool split) {
-  std::uint64_t& counter =
-      kind == SecondaryKind::Reflection ? ctx.counts.reflection : ctx.counts.refraction;
+// blurSamples rays (consecutive points of the lobe's sampler dimension); every ray below it is
+// marked `split`, and a split path uses a single cone ray at later glossy bounces (and fewer
+// area-light samples, see areaLightSampleCount). So a path tree holds at most blurSamples rays
+// per glossy lobe of its first glossy hit instead of blurSamples^depth.
+Color traceLobe(const TraceContext& ctx, const Point3& p, const Vec3& pError, const Normal3& n,
+                const Vec3& ideal, double blurDegrees, SecondaryKind kind, int depth,
+                const Color& weight, bool split, const SampleStream& stream) {
+  const bool reflection = kind == SecondaryKind::Reflection;
+  std::uint64_t& counter = reflection ? ctx.counts.reflection : ctx.counts.refraction;
+  const std::uint32_t dimension = reflection ? kReflectionDimension : kRefractionDimension;
   if (!(blurDegrees > 0)) {
     ++counter;
-    return trace(ctx, spawnRay(p, n, ideal), depth, weight, split);
+    return trace(ctx, spawnRay(p, pError, n, ideal), depth, weight, split,
+                 stream.branch(dimension, 1, 0));
   }
   const double cosMax = std::cos(std::min(blurDegrees, 180.0) * std::numbers::pi / 180.0);
   const double idealSide = dot(n, ideal);
-  const std::uint32_t count = split ? 1u : std::max<std::uint32_t>(ctx.blurSamples, 1u);
+  const std::uint32_t count = split ? 1u : ctx.blurSamples;
   const bool childSplit = split || count > 1;
-  // One scramble per lobe decorrelates the radical-inverse dimension between lobes and pixels.
-  const auto scramble = static_cast<std::uint32_t>(ctx.rng.nextBits() >> 32);
+  Vec3 tangent;
+  Vec3 bitangent;
+  orthonormalBasis(ideal, tangent, bitangent);
+  const SobolDimension2D directions = stream.dimension(dimension);
+  const std::uint64_t childKey = stream.branchKey(dimension);
   Color sum;
   std::uint32_t kept = 0;
   for (std::uint32_t k = 0; k < count; ++k) {
-    const double jitterX = ctx.rng.uniform();
-    const double jitterY = ctx.rng.uniform();
-    const Vec3 w = sampleCone(ideal, cosMax, stratified2D(k, count, jitterX, jitterY, scramble));
+    const std::uint32_t index = stream.subIndex(count, k);
+    const Vec3 w = sampleCone(ideal, tangent, bitangent, cosMax, directions.at(index));
     // Keep only directions that leave on the same side of the surface as the ideal one.
     if (!(dot(n, w) * idealSide > 0)) continue;
     ++counter;
-    sum += trace(ctx, spawnRay(p, n, w), depth, weight, childSplit);
+    sum += trace(ctx, spawnRay(p, pError, n, w), depth, weight, childSplit,
+                 SampleStream(childKey, index));
     ++kept;
   }
   if (kept == 0) {
     ++counter;
-    return trace(ctx, spawnRay(p, n, ideal), depth, weight, childSplit);
+    return trace(ctx, spawnRay(p, pError, n, ideal), depth, weight, childSplit,
+                 SampleStream(childKey, stream.subIndex(count, 0)));
   }
   return sum / static_cast<double>(kept);
 }
@@ -141,14 +232,18 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
 
 // The seed's calcColor with recursion. `depth` counts the surface hits already on this path
 // (0 for a camera ray), `weight` the product of kr/kt factors that scale this ray's contribution,
-// `split` whether the path has already fanned out into several glossy rays.
-Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split) {
+// `split` whether the path has already fanned out into several glossy rays, `stream` its samples.
+Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split,
+            const SampleStream& stream) {
   Hit hit;
   if (!ctx.scene.intersect(ray, kInfinity, hit)) return ctx.scene.background();
   const int hitDepth = depth + 1;
 
   const Material& material = ctx.scene.materialOf(hit);
-  const Point3 p = ray.at(hit.t);
+  // The reprojected hit point and its error bound: ray.at(hit.t) would carry rounding error that
+  // grows with the ray's origin and length, which no offset proportional to |p| covers.
+  const Point3& p = hit.point;
+  const Vec3& pError = hit.pointError;
   const Normal3& n = hit.normal;  // geometric: side decisions and ray origins
   const Vec3& v = ray.direction;  // unit for every ray the renderer creates
   const double nv = dot(n, v);
@@ -158,7 +253,8 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   const double nsv = dot(ns, v);
 
   Color color = ctx.scene.emissionOf(hit) + material.ka * ctx.scene.ambient();
-  color += directLight(ctx, material, p, n, ns, v);
+  color += directLight(ctx, ShadingPoint{material, p, pError, n, ns, v, nv, !isBlack(material.ks)},
+                       stream, split);
   if (hitDepth >= ctx.maxDepth) return color;
 
   // A mirror direction about ns that would dive below the geometric surface is replaced by the
@@ -168,8 +264,9 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   if (smooth && !(dot(n, reflected) * nv < 0)) reflected = v - toVec(n) * (2 * nv);
   Color branchWeight;
   if (worthTracing(material.kr, weight, ctx.minWeight, branchWeight)) {
-    color += material.kr * traceLobe(ctx, p, n, reflected, material.reflectionBlur,
-                                     SecondaryKind::Reflection, hitDepth, branchWeight, split);
+    color +=
+        material.kr * traceLobe(ctx, p, pError, n, reflected, material.reflectionBlur,
+                                SecondaryKind::Reflection, hitDepth, branchWeight, split, stream);
   }
   if (worthTracing(material.kt, weight, ctx.minWeight, branchWeight)) {
     Vec3 transmitted = v;
@@ -189,26 +286,23 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
         if (smooth && !(dot(n, transmitted) * nv > 0)) transmitted = v;
       }
     }
-    color += material.kt * traceLobe(ctx, p, n, transmitted, material.refractionBlur,
-                                     SecondaryKind::Refraction, hitDepth, branchWeight, split);
+    color +=
+        material.kt * traceLobe(ctx, p, pError, n, transmitted, material.refractionBlur,
+                                SecondaryKind::Refraction, hitDepth, branchWeight, split, stream);
   }
   return color;
 }
 
 // Shading assumes a unit view direction. Camera rays are unit already up to rounding; normalising
 // here anyway keeps render() and traceRay() bit-identical for the same ray.
-Color traceCameraRay(const TraceContext& ctx, const Ray& ray) {
+Color traceCameraRay(const TraceContext& ctx, const Ray& ray, const SampleStream& stream) {
   ++ctx.counts.camera;
-  return trace(ctx, Ray{ray.origin, normalize(ray.direction)}, 0, Color(1), false);
+  return trace(ctx, Ray{ray.origin, normalize(ray.direction)}, 0, Color(1), false, stream);
 }
 
-TraceContext makeContext(const Scene& scene, Rng& rng, RayCounts& counts) {
+TraceContext makeContext(const Scene& scene, RayCounts& counts) {
   const RenderSettings& settings = scene.render();
-  return TraceContext{scene,
-                      rng,
-                      counts,
-                      settings.maxDepth,
-                      settings.minWeight,
+  return TraceContext{scene, counts, settings.maxDepth, settings.minWeight,
                       static_cast<std::uint32_t>(std::max(settings.blurSamples, 1))};
 }
 
@@ -240,12 +334,83 @@ void paintGrid(Film& film, const GridOverlay& grid) {
   }
 }
 
-// A well-distributed but fixed scramble for the pixel's stratified pattern, independent of the
-// per-sample streams (sample index 0xffffffff is never a real sample).
-std::uint32_t pixelScramble(int column, int row, std::uint64_t seed) {
-  Rng rng = Rng::forPixelSample(static_cast<std::uint32_t>(column), static_cast<std::uint32_t>(row),
-                                0xffffffffu, seed);
-  return static_cast<std::uint32_t>(rng.nextBits() >> 32);
+// How many samples each pixel takes.
+struct SamplingPlan {
+  std::uint32_t initial = 1;  // every pixel takes these first
+  std::uint32_t maximum = 1;  // adaptive: the cap; otherwise = initial
+  std::uint32_t batch = 1;    // adaptive: samples added per refinement step
+  double threshold = 0;       // adaptive: the standard error to reach, linear color units
+  bool adaptive = false;
+  bool jitter = false;  // false: the single sample goes through the pixel centre (DESIGN.md §4)
+};
+
+SamplingPlan samplingPlan(const ImageSettings& image) {
+  SamplingPlan plan;
+  const auto samples = static_cast<std::uint32_t>(std::max(image.samples, 1));
+  plan.initial = plan.maximum = samples;
+  plan.jitter = samples > 1;
+  if (image.adaptive) {
+    plan.adaptive = true;
+    plan.jitter = true;
+    plan.maximum =
+        std::max(samples, static_cast<std::uint32_t>(std::max(image.adaptive->maxSamples, 1)));
+    plan.initial = std::min(std::max(samples, kMinAdaptiveSamples), plan.maximum);
+    plan.batch = plan.initial;
+    plan.threshold = image.adaptive->threshold;
+  }
+  return plan;
+}
+
+// The largest per-channel standard error of the mean of n samples with sums Σx and Σx²:
+// sqrt(s² / n) with the unbiased sample variance s² = (Σx² − (Σx)²/n) / (n − 1).
+double standardError(const Color& sum, const Color& sumSquares, std::uint32_t n) {
+  if (n < 2) return kInfinity;
+  const double count = n;
+  const auto channel = [count](double s, double s2) {
+    return std::max(0.0, s2 - s * s / count) / ((count - 1) * count);
+  };
+  return std::sqrt(std::max(
+      {channel(sum.r, sumSquares.r), channel(sum.g, sumSquares.g), channel(sum.b, sumSquares.b)}));
+}
+
+// The estimate of one pixel: the mean of its samples. Without adaptive sampling, exactly
+// image.samples samples. Adaptive (image.adaptive): `initial` samples, then batches of `batch`
+// more while the largest per-channel standard error of the pixel's mean (from the sample variance
+// of its own samples, linear color) exceeds the threshold, up to `maximum`. The decision reads only
+// this pixel's samples, so it is the same on any thread count, tile schedule or crop. (With
+// stratified Sobol samples the sample variance overestimates the mean's true error: the rule errs
+// toward more samples.) Sample s uses the sampler stream (pixel, s, seed); non-finite samples count
+// as black and are added to `nonFinite`.
+Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
+                  std::uint64_t seed, std::uint64_t& nonFinite) {
+  const Camera& camera = ctx.scene.camera();
+  // The key and the two camera dimensions are the same for every sample of the pixel.
+  const SampleStream pixel = SampleStream::forPixel(static_cast<std::uint32_t>(column),
+                                                    static_cast<std::uint32_t>(row), 0, seed);
+  const SobolDimension2D offsets = pixel.dimension(kPixelDimension);
+  const SobolDimension2D lens = pixel.dimension(kLensDimension);
+  Color sum;
+  Color sumSquares;
+  std::uint32_t n = 0;
+  std::uint32_t target = plan.initial;
+  for (;;) {
+    for (; n < target; ++n) {
+      const SampleStream stream(pixel.key(), n);
+      const Point2 offset = plan.jitter ? offsets.at(n) : Point2{0.5, 0.5};
+      const Ray ray = camera.generateRay(column, row, offset, lens.at(n));
+      Color value = traceCameraRay(ctx, ray, stream);
+      if (!isFinite(value)) {
+        value = Color{};
+        ++nonFinite;
+      }
+      sum += value;
+      if (plan.adaptive) sumSquares += value * value;
+    }
+    if (!plan.adaptive || n >= plan.maximum) break;
+    if (!(standardError(sum, sumSquares, n) > plan.threshold)) break;
+    target = std::min(n + plan.batch, plan.maximum);
+  }
+  return sum / static_cast<double>(n);
 }
 
 }  // namespace
@@ -253,8 +418,8 @@ std::uint32_t pixelScramble(int column, int row, std::uint64_t seed) {
 Color traceRay(const Scene& scene, const Ray& ray, Rng& rng, RayCounts* counts) {
   RayCounts local;
   RayCounts& target = counts ? *counts : local;
-  const TraceContext ctx = makeContext(scene, rng, target);
-  return traceCameraRay(ctx, ray);
+  const TraceContext ctx = makeContext(scene, target);
+  return traceCameraRay(ctx, ray, SampleStream(rng.nextBits(), 0));
 }
 
 std::vector<PixelRegion> tileRegions(const PixelRegion& region, int tileSize) {
@@ -285,9 +450,7 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
 
   const ImageSettings& image = scene.image();
   Film film(image.width, image.height, region);
-  const Camera& camera = scene.camera();
-  const int samples = std::max(image.samples, 1);
-  const auto sampleCount = static_cast<std::uint32_t>(samples);
+  const SamplingPlan plan = samplingPlan(image);
   const std::uint64_t seed = scene.render().seed;
 
   std::atomic<std::uint64_t> cameraRays{0}, shadowRays{0}, reflectionRays{0}, refractionRays{0};
@@ -328,41 +491,35 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
     const int x1 = tiles[tile].x1;
     const int y1 = tiles[tile].y1;
     RayCounts counts;
+    const TraceContext ctx = makeContext(scene, counts);
     std::uint64_t tileNonFinite = 0;
     std::optional<PixelCoord> tileFirstNonFinite;
-    for (int row = y0; row < y1; ++row) {
+    bool abandoned = false;
+    for (int row = y0; row < y1 && !abandoned; ++row) {
       for (int column = x0; column < x1; ++column) {
-        const std::uint32_t scramble = samples > 1 ? pixelScramble(column, row, seed) : 0;
-        Color sum;
-        for (std::uint32_t s = 0; s < sampleCount; ++s) {
-          Rng rng = Rng::forPixelSample(static_cast<std::uint32_t>(column),
-                                        static_cast<std::uint32_t>(row), s, seed);
-          Point2 offset{0.5, 0.5};
-          if (sampleCount > 1) {
-            const double jitterX = rng.uniform();
-            const double jitterY = rng.uniform();
-            offset = stratified2D(s, sampleCount, jitterX, jitterY, scramble);
-          }
-          // The lens sample is always drawn (a pinhole camera ignores it), so the glossy stream
-          // that follows does not depend on the camera model.
-          const double lensX = rng.uniform();
-          const double lensY = rng.uniform();
-          const Ray ray = camera.generateRay(column, row, offset, Point2{lensX, lensY});
-          const TraceContext ctx = makeContext(scene, rng, counts);
-          Color value = traceCameraRay(ctx, ray);
-          if (!isFinite(value)) {
-            value = Color{};
-            if (tileNonFinite++ == 0) tileFirstNonFinite = PixelCoord{column, row};
-          }
-          sum += value;
+        // Polled per pixel (a relaxed load), so a cancel takes effect within one pixel's samples.
+        if (cancelled.load(std::memory_order_relaxed) ||
+            (options.cancel && options.cancel->load(std::memory_order_relaxed))) {
+          cancelled.store(true);
+          abandoned = true;
+          break;
         }
-        film.at(column - region.x0, row - region.y0) = sum / static_cast<double>(sampleCount);
+        std::uint64_t pixelNonFinite = 0;
+        film.at(column - region.x0, row - region.y0) =
+            renderPixel(ctx, plan, column, row, seed, pixelNonFinite);
+        if (pixelNonFinite > 0 && tileNonFinite == 0) {
+          tileFirstNonFinite = PixelCoord{column, row};
+        }
+        tileNonFinite += pixelNonFinite;
       }
     }
+    // The rays of an abandoned tile were traced and count; its pixels are dropped and it is not
+    // reported as finished.
     cameraRays += counts.camera;
     shadowRays += counts.shadow;
     reflectionRays += counts.reflection;
     refractionRays += counts.refraction;
+    if (abandoned) return;
     nonFinite += tileNonFinite;
     const std::lock_guard<std::mutex> lock(progressMutex);
     if (tileFirstNonFinite && (!firstNonFinite || before(*tileFirstNonFinite, *firstNonFinite))) {

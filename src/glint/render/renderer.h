@@ -1,5 +1,7 @@
-// The Whitted/Phong renderer of DESIGN.md §3 (the seed's Render): tiles over a oneTBB pool, one
-// deterministic random stream per (pixel, sample, seed), so any thread count gives the same bytes.
+// The Whitted/Phong renderer of DESIGN.md §3 (the seed's Render) with distributed ray tracing
+// (anti-aliasing, adaptive sampling, area lights, depth of field, glossy lobes): tiles over a
+// oneTBB pool, sample points from core/sampler.h keyed by (pixel, sample, dimension, seed), so any
+// thread count or crop gives the same bytes.
 #pragma once
 
 #include <atomic>
@@ -31,8 +33,8 @@ struct PixelCoord {
 };
 
 struct RenderStats {
-  RayCounts rays;               // rays.camera is also the number of pixel samples spent
-  double seconds = 0;           // wall-clock time of the render
+  RayCounts rays;      // rays.camera is also the number of pixel samples spent (adaptive: in total)
+  double seconds = 0;  // wall-clock time of the render
   std::uint64_t nonFinite = 0;  // samples that came out NaN/inf and were replaced by black
   // Where the first non-finite sample arose: the smallest row, then column, among the pixels that
   // had one (so the same on any thread count).
@@ -42,10 +44,12 @@ struct RenderStats {
 };
 
 struct RenderOptions {
-  int threads = 0;                            // 0 = all cores
-  std::optional<PixelRegion> crop;            // default: the whole image
-  int tileSize = 16;                          // pixels per tile side
-  const std::atomic<bool>* cancel = nullptr;  // polled between tiles; when set, render stops
+  int threads = 0;                  // 0 = all cores
+  std::optional<PixelRegion> crop;  // default: the whole image
+  int tileSize = 16;                // pixels per tile side
+  // Polled before every pixel; when set, render stops within one pixel's samples per thread. A
+  // tile left unfinished is neither reported to tileFinished nor to progress.
+  const std::atomic<bool>* cancel = nullptr;
   // Called (from worker threads, serialised by the renderer) after each finished tile with
   // (tiles done, tiles total).
   std::function<void(std::size_t, std::size_t)> progress;
@@ -68,8 +72,9 @@ std::vector<PixelRegion> tileRegions(const PixelRegion& region, int tileSize);
 // partial film with stats.cancelled = true.
 Film render(const Scene& scene, const RenderOptions& options = {}, RenderStats* stats = nullptr);
 
-// Color seen along one ray (the seed's calcColor with recursion), for tests and tools.
-// `rng` supplies glossy sampling; depth counts surface hits already on this path.
+// Color seen along one ray (the seed's calcColor with recursion), for tests and tools. One value
+// of `rng` keys the sample stream (core/sampler.h, sequence index 0) of its glossy lobes and
+// area-light points.
 Color traceRay(const Scene& scene, const Ray& ray, Rng& rng, RayCounts* counts = nullptr);
 
 }  // namespace glint

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <limits>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -374,6 +376,185 @@ TEST(Renderer, TransmissionWithIorOneGoesStraightThrough) {
   EXPECT_EQ(c, Color(0, 0, 0.5));
   EXPECT_EQ(counts.refraction, 1u);
   EXPECT_EQ(counts.reflection, 0u);
+}
+
+// A diffuse, specular sphere over a diffuse floor, lit by one light: shadows, highlights and
+// distance falloff all depend on where the light is.
+SceneParts shadedSphereParts() {
+  SceneParts parts = baseParts(16, 12);
+  Material m;
+  m.kd = Color(0.7, 0.5, 0.3);
+  m.ks = Color(0.4);
+  m.shininess = 30;
+  m.ka = Color(0);
+  const std::uint32_t mi = addMaterial(parts, m);
+  parts.primitives.emplace_back(Sphere::make({0.3, 0, -5}, 1.2), mi, Color{});
+  parts.primitives.emplace_back(Plane::make({0, -1.2, 0}, {0, 1, 0}), mi, Color{});
+  return parts;
+}
+
+TEST(Renderer, AreaLightShrunkToAPointEqualsThePointLight) {
+  const Point3 position{1.5, 3, -2};
+  const Color intensity(3, 2.5, 2);
+  const Attenuation attenuation{1, 0.1, 0.02};
+  SceneParts pointParts = shadedSphereParts();
+  pointParts.lights.push_back(PointLight{position, intensity, attenuation});
+  const Film expected = render(Scene(std::move(pointParts)));
+
+  AreaLight rectangle;
+  rectangle.shape = AreaShape::Rectangle;
+  rectangle.corner = position;
+  AreaLight disk;
+  disk.shape = AreaShape::Disk;
+  disk.center = position;
+  disk.normal = {0, 1, 0};
+  AreaLight sphere;
+  sphere.shape = AreaShape::Sphere;
+  sphere.center = position;
+  int shaded = 0;
+  for (AreaLight light : {rectangle, disk, sphere}) {
+    light.intensity = intensity;
+    light.attenuation = attenuation;
+    light.samples = 5;
+    SceneParts parts = shadedSphereParts();
+    parts.lights.push_back(light);
+    RenderStats stats;
+    const Film film = render(Scene(std::move(parts)), {}, &stats);
+    for (std::size_t i = 0; i < film.pixels().size(); ++i) {
+      const Color& a = film.pixels()[i];
+      const Color& e = expected.pixels()[i];
+      EXPECT_NEAR(a.r, e.r, 1e-12 * (1 + e.r)) << static_cast<int>(light.shape) << " pixel " << i;
+      EXPECT_NEAR(a.g, e.g, 1e-12 * (1 + e.g));
+      EXPECT_NEAR(a.b, e.b, 1e-12 * (1 + e.b));
+      shaded += e.r > 0;
+    }
+    EXPECT_EQ(stats.rays.shadow % 5, 0u);  // five shadow rays per lit hit
+  }
+  EXPECT_GT(shaded, 100);
+}
+
+TEST(Renderer, AreaLightSamplesFallBelowAGlossySplit) {
+  // Glossy mirror A (z = -5, normal +z; kd > 0) splits into blurSamples = 4 rays that reach the
+  // diffuse wall B (z = +5, normal −z). A small area light between them with samples = 7 lights
+  // both sides: A (unsplit) takes 7 shadow rays, each of the 4 split paths ⌈7/4⌉ = 2.
+  SceneParts parts = baseParts(3, 3);
+  Material glossy;
+  glossy.kd = Color(0.5);
+  glossy.kr = Color(0.5);
+  glossy.reflectionBlur = 2;
+  Material wall;
+  wall.kd = Color(0.5);
+  parts.primitives.emplace_back(Plane::make({0, 0, -5}, {0, 0, 1}), addMaterial(parts, glossy),
+                                Color{});
+  parts.primitives.emplace_back(Plane::make({0, 0, 5}, {0, 0, -1}), addMaterial(parts, wall),
+                                Color{});
+  AreaLight light;
+  light.corner = {2, 2, 0};
+  light.edge1 = {0.5, 0, 0};
+  light.edge2 = {0, 0.5, 0};
+  light.intensity = Color(1);
+  light.samples = 7;
+  parts.lights.push_back(light);
+  parts.render.blurSamples = 4;
+  parts.render.maxDepth = 2;
+  const Scene scene(std::move(parts));
+  RayCounts counts;
+  Rng rng(3);
+  const Color c = traceRay(scene, Ray{{0, 0, 0}, {0, 0, -1}}, rng, &counts);
+  EXPECT_GT(c.r, 0.0);
+  EXPECT_EQ(counts.reflection, 4u);
+  EXPECT_EQ(counts.shadow, 7u + 4u * 2u);
+}
+
+// An emissive white sphere on black whose silhouette crosses pixels (see the supersampling test).
+SceneParts silhouetteParts(int samples) {
+  SceneParts parts = baseParts(15, 15);
+  parts.background = Color(0);
+  parts.primitives.emplace_back(Sphere::make({0, 0, -5}, 2), 0u, Color(1, 1, 1));
+  parts.image.samples = samples;
+  return parts;
+}
+
+std::uint64_t cameraRaysOfCrop(const Scene& scene, const PixelRegion& crop) {
+  RenderOptions options;
+  options.crop = crop;
+  RenderStats stats;
+  render(scene, options, &stats);
+  return stats.rays.camera;
+}
+
+TEST(Renderer, AdaptiveSamplingRefinesOnlyWhereSamplesDisagree) {
+  SceneParts parts = silhouetteParts(4);
+  parts.image.adaptive = AdaptiveSampling{12, 1e-6};
+  const Scene scene(std::move(parts));
+  RenderStats stats;
+  const Film film = render(scene, {}, &stats);
+  // Flat pixels (inside, outside) stop after the first 4 samples; an edge pixel goes to the cap
+  // in batches of 4 (4 → 8 → 12).
+  EXPECT_EQ(cameraRaysOfCrop(scene, {7, 7, 8, 8}), 4u);
+  EXPECT_EQ(cameraRaysOfCrop(scene, {0, 0, 1, 1}), 4u);
+  EXPECT_EQ(film.at(7, 7), Color(1, 1, 1));
+  EXPECT_EQ(film.at(0, 0), Color(0, 0, 0));
+  std::uint64_t refined = 0;
+  for (int y = 0; y < 15; ++y) {
+    for (int x = 0; x < 15; ++x) {
+      const std::uint64_t spent = cameraRaysOfCrop(scene, {x, y, x + 1, y + 1});
+      EXPECT_TRUE(spent == 4u || spent == 12u) << x << "," << y << ": " << spent;
+      // A pixel whose samples disagree (a value strictly between black and white) was refined.
+      const double value = film.at(x, y).r;
+      if (value > 0 && value < 1) {
+        EXPECT_EQ(spent, 12u) << x << "," << y;
+      }
+      refined += spent == 12u;
+    }
+  }
+  // Most of the silhouette's pixels (4 samples can all land on one side of the edge, and then
+  // the pixel stops: the decision sees only the pixel's own samples).
+  EXPECT_GE(refined, 12u);
+  EXPECT_GT(stats.rays.camera, 15u * 15u * 4u);
+  EXPECT_LT(stats.rays.camera, 15u * 15u * 12u);
+
+  // A generous threshold refines less than a strict one; maxSamples = samples means fixed.
+  SceneParts loose = silhouetteParts(4);
+  loose.image.adaptive = AdaptiveSampling{12, 0.3};
+  RenderStats looseStats;
+  render(Scene(std::move(loose)), {}, &looseStats);
+  EXPECT_LT(looseStats.rays.camera, stats.rays.camera);
+  SceneParts capped = silhouetteParts(4);
+  capped.image.adaptive = AdaptiveSampling{4, 1e-6};
+  RenderStats cappedStats;
+  render(Scene(std::move(capped)), {}, &cappedStats);
+  EXPECT_EQ(cappedStats.rays.camera, 15u * 15u * 4u);
+}
+
+TEST(Renderer, CancelStopsInsideATileWithoutReportingIt) {
+  // One 64×64 tile at 256 samples per pixel: about a million camera samples, far more than the
+  // render can do before the cancel arrives; it must stop mid-tile, not at the tile's end.
+  SceneParts parts = litPlaneParts(64, 64);
+  parts.image.samples = 256;
+  const Scene scene(std::move(parts));
+  std::atomic<bool> cancel{false};
+  RenderOptions options;
+  options.cancel = &cancel;
+  options.threads = 1;
+  options.tileSize = 64;
+  std::size_t reports = 0;
+  options.progress = [&](std::size_t, std::size_t) { ++reports; };
+  options.tileFinished = [&](std::size_t, const Film&) { ++reports; };
+  std::thread canceller([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    cancel = true;
+  });
+  RenderStats stats;
+  const auto start = std::chrono::steady_clock::now();
+  render(scene, options, &stats);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  canceller.join();
+  EXPECT_TRUE(stats.cancelled);
+  EXPECT_EQ(reports, 0u);
+  EXPECT_LT(stats.rays.camera, 64u * 64u * 256u);
+  EXPECT_LT(seconds, 2.0);
 }
 
 }  // namespace

@@ -71,4 +71,17 @@ struct LightSample {
 // the renderer samples its surface instead.
 LightSample illuminate(const Light& light, const Point3& p);
 
+// A point on an area light for the sample u in [0,1)², the light seen from P (world space):
+//   rectangle: corner + u.x·edge1 + u.y·edge2, uniform by area;
+//   disk: centre + radius·(concentric-disk point) in the disk's plane, uniform by area;
+//   sphere: where a direction drawn uniformly by solid angle from the cone of directions from P
+//     that meet the sphere first hits it (the cap visible from P); P inside or on the sphere: a
+//     point uniform over the whole surface.
+// Every such point stands for one point light of intensity I0 (DESIGN.md §3 area lights).
+Point3 sampleAreaLight(const AreaLight& light, const Point3& p, const Point2& u);
+
+// I_L(P) and l of one area-light point x, as a point light of I0 at x: attenuated by |P − x|.
+// Zero intensity when P = x.
+LightSample illuminateFrom(const AreaLight& light, const Point3& x, const Point3& p);
+
 }  // namespace glint

@@ -30,7 +30,7 @@ struct GridOverlay {
 // than threshold (linear color units).
 struct AdaptiveSampling {
   int maxSamples = 64;      // per pixel, ≥ ImageSettings::samples
-  double threshold = 0.05;  // > 0
+  double threshold = 0.02;  // > 0
 };
 
 struct ImageSettings {
