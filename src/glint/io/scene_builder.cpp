@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include <fmt/format.h>
@@ -32,6 +33,9 @@ bool BuildResult::hasErrors() const {
 
 namespace {
 
+// area light.samples: shadow rays per shading point, the same bound as samples per pixel.
+constexpr std::int64_t kMaxAreaLightSamples = 65536;
+
 // up is refused when the sine of its angle to the view direction is at most this; the camera uses
 // the same bound (scene/camera.cpp), so a scene that builds here never fails there.
 constexpr double kParallelSine = 1e-6;
@@ -51,6 +55,8 @@ const char* typeLabel(LightType type) {
       return "point";
     case LightType::Spot:
       return "spot";
+    case LightType::Area:
+      return "area";
   }
   return "light";
 }
@@ -206,7 +212,45 @@ class Builder {
         sizeOk = false;
       }
     }
+    if (image.adaptive) buildAdaptive(*image.adaptive, sizeOk);
     imageOk_ = sizeOk && errorCount() == errorsBefore;
+  }
+
+  // image.adaptive, after image.samples: max_samples may not be below the fixed count, and the
+  // worst case (every pixel taking max_samples) must pass the same camera-ray limit.
+  void buildAdaptive(const AdaptiveDescription& a, bool sizeOk) {
+    AdaptiveSampling adaptive;  // the defaults
+    bool maxOk = true;
+    if (a.maxSamples) {
+      maxOk = inRange(*a.maxSamples, 1, kMaxSamplesPerPixel, "image.adaptive.max_samples");
+      if (maxOk) adaptive.maxSamples = static_cast<int>(a.maxSamples->value);
+    }
+    if (a.threshold && positive(*a.threshold, "image.adaptive.threshold")) {
+      adaptive.threshold = a.threshold->value;
+    }
+    const ImageDescription& image = *d_.image;
+    const bool samplesOk = !image.samples || (image.samples->value >= 1 &&
+                                              image.samples->value <= kMaxSamplesPerPixel);
+    if (maxOk && samplesOk && adaptive.maxSamples < parts_.image.samples) {
+      if (a.maxSamples) {
+        error(a.maxSamples->where,
+              fmt::format("image.adaptive.max_samples must be >= image.samples ({}), got {}",
+                          parts_.image.samples, adaptive.maxSamples));
+      } else {
+        error(a.where, fmt::format("image.adaptive.max_samples (default {}) must be >= "
+                                   "image.samples ({}); give a larger max_samples",
+                                   adaptive.maxSamples, parts_.image.samples));
+      }
+      maxOk = false;
+    }
+    if (maxOk && sizeOk && adaptive.maxSamples > parts_.image.samples) {
+      if (auto problem = checkRenderSize(parts_.image.width, parts_.image.height,
+                                         adaptive.maxSamples, options_.imageMemoryBudget)) {
+        error(a.maxSamples ? a.maxSamples->where : a.where,
+              "image.adaptive.max_samples: " + *problem);
+      }
+    }
+    parts_.image.adaptive = adaptive;
   }
 
   void buildRender() {
@@ -312,7 +356,15 @@ class Builder {
       spec.focusDistance = c.focusDistance->value;
     }
     if (c.aperture && c.aperture->value > 0 && !c.focusDistance) {
-      error(c.aperture->where, "camera.focus_distance is required when camera.aperture > 0");
+      // The point looked at is in focus unless focus_distance says otherwise; it lies on the view
+      // axis, so its distance is the distance along vTo.
+      if (c.lookAt && c.position && direction) {
+        spec.focusDistance = length(c.lookAt->value - c.position->value);
+      } else if (!c.lookAt) {
+        error(c.aperture->where,
+              "camera.focus_distance is required when camera.aperture > 0 and the camera has no "
+              "look_at (with look_at it defaults to the distance to that point)");
+      }
     }
     spec.imageWidth = parts_.image.width;
     spec.imageHeight = parts_.image.height;
@@ -551,7 +603,9 @@ class Builder {
   // "box min must be < max") — "objects[2] (triangle).vertices are collinear: ..." — else at the
   // object — "objects[2] (polygon): ...".
   void shapeError(const ObjectDescription& o, const std::string& what) {
-    const std::string prefix = fmt::format("objects[{}] ({})", o.index, o.typeName);
+    shapeError(o, what, fmt::format("objects[{}] ({})", o.index, o.typeName));
+  }
+  void shapeError(const ObjectDescription& o, const std::string& what, const std::string& prefix) {
     std::string_view rest = what;
     if (rest.size() > o.typeName.size() && rest.compare(0, o.typeName.size(), o.typeName) == 0 &&
         rest[o.typeName.size()] == ' ') {
@@ -600,7 +654,9 @@ class Builder {
     const std::filesystem::path path = written.is_relative() ? d_.baseDirectory / written : written;
     std::shared_ptr<const MeshFile> file;
     try {
-      file = meshCache_.load(path);
+      // Estimated (mesh + BVH, with the film) against the memory limit before anything is read.
+      file = meshCache_.load(path, MeshBudget{options_.imageMemoryBudget,
+                                              filmBytes(parts_.image.width, parts_.image.height)});
     } catch (const MeshLoadError& e) {
       std::string reason = e.what();
       if (path != written && reason == "no such file") {
@@ -693,6 +749,10 @@ class Builder {
     }
     double exponent = 1;
     if (l.exponent && nonNegative(*l.exponent, owner + ".exponent")) exponent = l.exponent->value;
+    if (l.type == LightType::Area) {
+      buildAreaLight(l, power, attenuation, errorsBefore);
+      return;
+    }
 
     std::optional<Vec3> direction;
     if (l.type != LightType::Point) {
@@ -716,10 +776,56 @@ class Builder {
       case LightType::Spot:
         parts_.lights.push_back(SpotLight{*position, *direction, power, attenuation, exponent});
         break;
+      case LightType::Area:
+        break;  // buildAreaLight
     }
     if (isBlack(power)) {
       warning(l.where, fmt::format("{} has zero intensity; it lights nothing", owner));
     }
+  }
+
+  // An area light's surface goes through shape() and the shape factories exactly as the object of
+  // that shape would (the same ranges, tolerance and messages), then lends the light its geometry.
+  void buildAreaLight(const LightDescription& l, const Color& power, const Attenuation& attenuation,
+                      std::size_t errorsBefore) {
+    AreaLight light;
+    light.intensity = power;
+    light.attenuation = attenuation;
+    if (l.samples && inRange(*l.samples, 1, kMaxAreaLightSamples, "area light.samples")) {
+      light.samples = static_cast<int>(l.samples->value);
+    }
+    if (!l.surface) {
+      // The parser reported the missing or unknown shape; a hand-made description may lack it.
+      if (l.complete) error(l.where, "area light is missing required key 'shape'");
+      return;
+    }
+    const ObjectDescription& surface = *l.surface;
+    std::optional<Shape> shaped;
+    try {
+      shaped = shape(surface);
+    } catch (const std::invalid_argument& e) {  // ShapeError
+      shapeError(surface, e.what(), fmt::format("lights[{}] (area light)", l.index));
+    }
+    if (!shaped || !l.complete || errorCount() != errorsBefore) return;
+    if (const auto* r = std::get_if<Rectangle>(&*shaped)) {
+      light.shape = AreaShape::Rectangle;
+      light.corner = r->corner;
+      light.edge1 = r->edge0;
+      light.edge2 = r->edge1;
+    } else if (const auto* disk = std::get_if<Disk>(&*shaped)) {
+      light.shape = AreaShape::Disk;
+      light.center = disk->center;
+      light.normal = Vec3{disk->normal.x, disk->normal.y, disk->normal.z};
+      light.radius = disk->radius;
+    } else if (const auto* sphere = std::get_if<Sphere>(&*shaped)) {
+      light.shape = AreaShape::Sphere;
+      light.center = sphere->center;
+      light.radius = sphere->radius;
+    } else {
+      return;  // the parser admits no other shape
+    }
+    parts_.lights.push_back(light);
+    if (isBlack(power)) warning(l.where, "area light has zero intensity; it lights nothing");
   }
 
   // Objects shade black without any light, ambient, emission or mirror/glass to show the

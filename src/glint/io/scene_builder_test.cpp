@@ -851,5 +851,255 @@ TEST(SceneBuilder, MeshesCountForTheUnlitWarning) {
                   .warnings.empty());
 }
 
+// The column (1-based) where `token` first starts in `line`.
+int columnOf(const std::string& line, const std::string& token) {
+  const std::size_t at = line.find(token);
+  EXPECT_NE(at, std::string::npos) << token << " not in " << line;
+  return static_cast<int>(at) + 1;
+}
+
+TEST(SceneBuilder, AreaLightsOfEachShape) {
+  const SceneParts p = partsOf(
+      std::string(kMinimal) +
+      "lights:\n"
+      "  - {type: area, shape: rectangle, corner: [-1, 4, -1], edges: [[2, 0, 0], [0, 0, 3]],\n"
+      "     color: [1, 0.5, 0.25], intensity: 2, attenuation: [1, 0, 0.01], samples: 32}\n"
+      "  - {type: area, shape: disk, center: [0, 5, 0], normal: [0, -2, 0], radius: 0.5}\n"
+      "  - {type: area, shape: sphere, center: [1, 2, 3], radius: 0.25, samples: 1,\n"
+      "     color: \"#ffffff\", intensity: 0.5}\n");
+  ASSERT_EQ(p.lights.size(), 3u);
+
+  const AreaLight& rect = std::get<AreaLight>(p.lights[0]);
+  EXPECT_EQ(rect.shape, AreaShape::Rectangle);
+  EXPECT_EQ(rect.corner, (Point3{-1, 4, -1}));
+  EXPECT_EQ(rect.edge1, (Vec3{2, 0, 0}));
+  EXPECT_EQ(rect.edge2, (Vec3{0, 0, 3}));
+  EXPECT_EQ(rect.intensity, Color(2, 1, 0.5));  // color × intensity
+  EXPECT_EQ(rect.attenuation.kc, 1);
+  EXPECT_EQ(rect.attenuation.kl, 0);
+  EXPECT_EQ(rect.attenuation.kq, 0.01);
+  EXPECT_EQ(rect.samples, 32);
+
+  // Defaults: white, intensity 1, attenuation [1, 0, 0] like a point light, AreaLight's samples.
+  const AreaLight& disk = std::get<AreaLight>(p.lights[1]);
+  EXPECT_EQ(disk.shape, AreaShape::Disk);
+  EXPECT_EQ(disk.center, (Point3{0, 5, 0}));
+  EXPECT_EQ(disk.normal, (Vec3{0, -1, 0}));  // normalised
+  EXPECT_EQ(disk.radius, 0.5);
+  EXPECT_EQ(disk.intensity, Color(1));
+  EXPECT_EQ(disk.attenuation.kc, 1);
+  EXPECT_EQ(disk.attenuation.kl, 0);
+  EXPECT_EQ(disk.attenuation.kq, 0);
+  EXPECT_EQ(disk.samples, AreaLight{}.samples);
+  EXPECT_EQ(disk.samples, 16);
+
+  const AreaLight& sphere = std::get<AreaLight>(p.lights[2]);
+  EXPECT_EQ(sphere.shape, AreaShape::Sphere);
+  EXPECT_EQ(sphere.center, (Point3{1, 2, 3}));
+  EXPECT_EQ(sphere.radius, 0.25);
+  EXPECT_EQ(sphere.samples, 1);
+  expectNear(sphere.intensity, Color(0.5));
+}
+
+TEST(SceneBuilder, AreaLightErrorsAtTheValue) {
+  const std::string lights = std::string(kMinimal) + "lights:\n";
+  const auto expectLightError = [&](const std::string& light, const std::string& token,
+                                    const std::string& fragment) {
+    const std::string line = "  - " + light;
+    expectOneError(lights + line + "\n", 4, columnOf(line, token), fragment);
+  };
+  const std::string rect = "{type: area, shape: rectangle, corner: [0, 4, 0], ";
+  expectLightError(rect + "edges: [[1, 0, 0], [1, 0, 1]]}", "[[1, 0, 0]",
+                   "lights[0] (area light).edges must be perpendicular, got [1, 0, 0] and "
+                   "[1, 0, 1] at 45 degrees");
+  expectLightError(rect + "edges: [[1, 0, 0], [0, 0, 0]]}", "[[1, 0, 0]",
+                   "lights[0] (area light).edges[1] must be a non-zero vector");
+  const std::string disk = "{type: area, shape: disk, center: [0, 4, 0], ";
+  expectLightError(disk + "normal: [0, 0, 0], radius: 1}", "[0, 0, 0]",
+                   "area light.normal must be non-zero, got [0, 0, 0]");
+  expectLightError(disk + "normal: [0, 1, 0], radius: 0}", "0}",
+                   "area light.radius must be > 0, got 0");
+  const std::string sphere = "{type: area, shape: sphere, center: [0, 4, 0], radius: 1, ";
+  expectLightError("{type: area, shape: sphere, center: [0, 4, 0], radius: -1}", "-1",
+                   "area light.radius must be > 0, got -1");
+  expectLightError(sphere + "samples: 0}", "0}",
+                   "area light.samples must be between 1 and 65536, got 0");
+  expectLightError(sphere + "samples: 65537}", "65537",
+                   "area light.samples must be between 1 and 65536, got 65537");
+  expectLightError(sphere + "intensity: -1}", "-1", "area light.intensity must be >= 0, got -1");
+  expectLightError(sphere + "color: [1, -1, 1]}", "[1, -1, 1]",
+                   "area light.color components must be >= 0");
+  expectLightError(sphere + "attenuation: [0, 0, 0]}", "[0, 0, 0]",
+                   "area light.attenuation must not be all 0");
+  expectLightError(sphere + "attenuation: [1, -1, 0]}", "[1, -1, 0]",
+                   "area light.attenuation components must be >= 0");
+  // The index names the light among several.
+  const std::string second = "  - " + rect + "edges: [[1, 0, 0], [1, 1, 0]]}";
+  expectOneError(lights + "  - {type: point, position: [0, 4, 0]}\n" + second + "\n", 5,
+                 columnOf(second, "[[1, 0, 0]"),
+                 "lights[1] (area light).edges must be perpendicular");
+  // A zero-intensity area light is a warning, like the other lights.
+  const LoadedScene dark =
+      loadSceneFromString(lights + "  - " + sphere + "intensity: 0}\n", "test.yaml");
+  ASSERT_EQ(dark.warnings.size(), 1u);
+  EXPECT_THAT(dark.warnings[0].message, HasSubstr("area light has zero intensity"));
+}
+
+TEST(SceneBuilder, AreaLightHandMadeDescriptions) {
+  SceneDescription d;
+  d.file = "made.yaml";
+  d.image = ImageDescription{};
+  d.image->width = Located<std::int64_t>{64, {}};
+  d.image->height = Located<std::int64_t>{48, {}};
+  d.camera = CameraDescription{};
+  d.camera->position = Located<Point3>{{0, 0, 0}, {}};
+  d.camera->direction = Located<Vec3>{{0, 0, -1}, {}};
+  d.camera->fov = Located<double>{60, {}};
+  LightDescription light;
+  light.type = LightType::Area;
+  light.typeName = "area";
+  light.where = {"made.yaml", 7, 5};
+  d.lights.push_back(light);
+  // A complete light without a surface: the builder reports the missing shape itself.
+  BuildResult r = buildScene(d);
+  ASSERT_EQ(r.diagnostics.size(), 1u);
+  EXPECT_EQ(r.diagnostics[0].format(), "made.yaml:7:5: area light is missing required key 'shape'");
+
+  ObjectDescription disk;
+  disk.type = ShapeType::Disk;
+  disk.typeName = "area light";
+  disk.where = light.where;
+  disk.center = Located<Point3>{{0, 3, 0}, {}};
+  disk.normal = Located<Vec3>{{0, -1, 0}, {}};
+  d.lights[0].surface = disk;
+  r = buildScene(d);
+  ASSERT_EQ(r.diagnostics.size(), 1u);
+  EXPECT_EQ(r.diagnostics[0].format(),
+            "made.yaml:7:5: area light is missing required key 'radius'");
+
+  d.lights[0].surface->radius = Located<double>{0.5, {}};
+  r = buildScene(d);
+  ASSERT_FALSE(r.hasErrors()) << r.diagnostics[0].format();
+  const AreaLight& built = std::get<AreaLight>(r.parts.lights.at(0));
+  EXPECT_EQ(built.shape, AreaShape::Disk);
+  EXPECT_EQ(built.radius, 0.5);
+  EXPECT_EQ(built.samples, AreaLight{}.samples);
+}
+
+TEST(SceneBuilder, AreaRectangleIsValidatedLikeTheRectangleObject) {
+  // The same edges are accepted or refused alike, at the same tolerance, for both.
+  int accepted = 0;
+  int refused = 0;
+  for (const double skew : {0.0, 1e-13, 1e-10, 1e-8, 1e-6, 1e-3, 0.5}) {
+    const std::string edges = fmt::format("edges: [[2, 0, 0], [{}, 0, 3]]", skew);
+    const bool objectOk =
+        errorsOf(std::string(kMinimal) + "objects:\n  - {type: rectangle, corner: [0, 0, 0], " +
+                 edges + "}\n")
+            .empty();
+    const bool lightOk =
+        errorsOf(std::string(kMinimal) +
+                 "lights:\n  - {type: area, shape: rectangle, corner: [0, 0, 0], " + edges + "}\n")
+            .empty();
+    EXPECT_EQ(objectOk, lightOk) << edges;
+    (lightOk ? accepted : refused) += 1;
+  }
+  EXPECT_GT(accepted, 0);
+  EXPECT_GT(refused, 0);
+}
+
+TEST(SceneBuilder, AdaptiveSampling) {
+  const std::string camera = "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n";
+  EXPECT_FALSE(partsOf(std::string(kMinimal)).image.adaptive);
+
+  // Absent keys take AdaptiveSampling's defaults (the one place they are written).
+  const SceneParts defaults = partsOf(camera + "image: {width: 4, height: 3, adaptive: {}}\n");
+  ASSERT_TRUE(defaults.image.adaptive);
+  EXPECT_EQ(defaults.image.adaptive->maxSamples, AdaptiveSampling{}.maxSamples);
+  EXPECT_EQ(defaults.image.adaptive->threshold, AdaptiveSampling{}.threshold);
+  EXPECT_EQ(defaults.image.adaptive->maxSamples, 64);
+  EXPECT_EQ(defaults.image.adaptive->threshold, 0.02);
+
+  const SceneParts set =
+      partsOf(camera +
+              "image: {width: 4, height: 3, samples: 4, adaptive: {max_samples: 256, "
+              "threshold: 0.01}}\n");
+  ASSERT_TRUE(set.image.adaptive);
+  EXPECT_EQ(set.image.samples, 4);
+  EXPECT_EQ(set.image.adaptive->maxSamples, 256);
+  EXPECT_EQ(set.image.adaptive->threshold, 0.01);
+  // max_samples may equal samples (adaptive then adds nothing).
+  const SceneParts equal =
+      partsOf(camera + "image: {width: 4, height: 3, samples: 8, adaptive: {max_samples: 8}}\n");
+  ASSERT_TRUE(equal.image.adaptive);
+  EXPECT_EQ(equal.image.adaptive->maxSamples, 8);
+
+  const auto expectImageError = [&](const std::string& image, const std::string& token,
+                                    const std::string& fragment) {
+    expectOneError(camera + image + "\n", 2, columnOf(image, token), fragment);
+  };
+  expectImageError("image: {width: 4, height: 3, adaptive: {max_samples: 0}}", "0}",
+                   "image.adaptive.max_samples must be between 1 and 65536, got 0");
+  expectImageError("image: {width: 4, height: 3, adaptive: {max_samples: 65537}}", "65537",
+                   "image.adaptive.max_samples must be between 1 and 65536, got 65537");
+  expectImageError("image: {width: 4, height: 3, samples: 8, adaptive: {max_samples: 4}}", "4}",
+                   "image.adaptive.max_samples must be >= image.samples (8), got 4");
+  // The default max_samples below samples: at the mapping, naming the default.
+  expectImageError("image: {width: 4, height: 3, samples: 100, adaptive: {threshold: 0.1}}",
+                   "{threshold",
+                   "image.adaptive.max_samples (default 64) must be >= image.samples (100)");
+  expectImageError("image: {width: 4, height: 3, adaptive: {threshold: 0}}", "0}",
+                   "image.adaptive.threshold must be > 0, got 0");
+  expectImageError("image: {width: 4, height: 3, adaptive: {threshold: -0.1}}", "-0.1",
+                   "image.adaptive.threshold must be > 0, got -0.1");
+  // An invalid samples is one error, not also a comparison with it.
+  expectImageError("image: {width: 4, height: 3, samples: 0, adaptive: {max_samples: 4}}", "0,",
+                   "image.samples must be between 1 and 65536, got 0");
+
+  // The worst case (every pixel at max_samples) must pass the camera-ray limit, refused at
+  // max_samples before anything is allocated.
+  const std::string hugeImage =
+      "image: {width: 65535, height: 65535, adaptive: {max_samples: 65536}}";
+  const ParseResult huge = parseScene(camera + hugeImage + "\n", "test.yaml");
+  ASSERT_FALSE(huge.hasErrors());
+  BuildOptions unlimited;
+  unlimited.imageMemoryBudget = std::numeric_limits<std::uint64_t>::max();
+  const BuildResult built = buildScene(huge.description, unlimited);
+  ASSERT_EQ(built.diagnostics.size(), 1u);
+  EXPECT_EQ(built.diagnostics[0].where.line, 2);
+  EXPECT_EQ(built.diagnostics[0].where.column, columnOf(hugeImage, "65536"));
+  EXPECT_THAT(built.diagnostics[0].message,
+              HasSubstr("image.adaptive.max_samples: an image of 65535 × 65535 pixels with 65536 "
+                        "samples per pixel needs"));
+}
+
+TEST(SceneBuilder, FocusDistanceDefaultsToTheLookAtPoint) {
+  const std::string image = "image: {width: 4, height: 3}\n";
+  // |(3, 0, -4) − (0, 0, 0)| = 5: the point looked at is in focus.
+  const SceneParts lookAt = partsOf(
+      "camera: {position: [0, 0, 0], look_at: [3, 0, -4], fov: 40, aperture: 0.2}\n" + image);
+  EXPECT_EQ(lookAt.camera.aperture, 0.2);
+  EXPECT_EQ(lookAt.camera.focusDistance, 5);
+  // An explicit focus_distance wins.
+  const SceneParts given = partsOf(
+      "camera: {position: [0, 0, 0], look_at: [3, 0, -4], fov: 40, aperture: 0.2,\n"
+      "         focus_distance: 2.5}\n" +
+      image);
+  EXPECT_EQ(given.camera.focusDistance, 2.5);
+  // Without aperture nothing is in or out of focus; the distance stays unset.
+  EXPECT_EQ(partsOf("camera: {position: [0, 0, 0], look_at: [3, 0, -4], fov: 40}\n" + image)
+                .camera.focusDistance,
+            0);
+  // With direction there is no point to focus on: focus_distance is required.
+  expectOneError(
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40, aperture: 0.5}\n" + image, 1,
+      73,
+      "camera.focus_distance is required when camera.aperture > 0 and the camera has no "
+      "look_at");
+  // A look_at equal to the position is one error (at look_at), not also a focus error.
+  expectOneError(
+      "camera: {position: [1, 2, 3], look_at: [1, 2, 3], fov: 40, aperture: 1}\n" + image, 1, 40,
+      "camera.look_at must differ from camera.position");
+}
+
 }  // namespace
 }  // namespace glint

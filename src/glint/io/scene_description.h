@@ -92,7 +92,7 @@ struct ObjectDescription {
   std::vector<TransformStep> transform;  // applied in file order
 };
 
-enum class LightType { Directional, Point, Spot };
+enum class LightType { Directional, Point, Spot, Area };
 
 struct LightDescription {
   LightType type = LightType::Point;
@@ -107,6 +107,13 @@ struct LightDescription {
   std::optional<Located<Vec3>> direction;
   std::optional<Located<std::array<double, 3>>> attenuation;  // [kc, kl, kq]
   std::optional<Located<double>> exponent;
+
+  // Area lights only. `surface` is the emitting shape, read with the geometry keys of the object of
+  // that shape (type Rectangle, Disk or Sphere; typeName "area light" names it in messages; no
+  // material, emission or transform). Absent when `shape` is missing or unknown.
+  std::optional<ObjectDescription> surface;
+  std::optional<Located<std::string>> shape;     // as written: "rectangle", "disk", "sphere"
+  std::optional<Located<std::int64_t>> samples;  // shadow rays per shading point
 };
 
 struct ViewPlaneDescription {
@@ -131,11 +138,19 @@ struct GridDescription {
   std::optional<ColorValue> color;
 };
 
+// image.adaptive; absent keys take the defaults of AdaptiveSampling.
+struct AdaptiveDescription {
+  SourceLocation where;
+  std::optional<Located<std::int64_t>> maxSamples;
+  std::optional<Located<double>> threshold;
+};
+
 struct ImageDescription {
   SourceLocation where;
   std::optional<Located<std::int64_t>> width, height, samples;
   std::optional<Located<Encoding>> encoding;
   std::optional<GridDescription> grid;
+  std::optional<AdaptiveDescription> adaptive;
 };
 
 struct RenderDescription {

@@ -34,8 +34,9 @@ const Keys kTopKeys = {"name",   "background", "ambient", "camera", "image",
 const Keys kCameraKeys = {"position",   "direction", "look_at",  "up",
                           "view_plane", "fov",       "aperture", "focus_distance"};
 const Keys kViewPlaneKeys = {"width", "height", "distance"};
-const Keys kImageKeys = {"width", "height", "samples", "encoding", "grid"};
+const Keys kImageKeys = {"width", "height", "samples", "encoding", "grid", "adaptive"};
 const Keys kGridKeys = {"interval", "color"};
+const Keys kAdaptiveKeys = {"max_samples", "threshold"};
 const Keys kRenderKeys = {"max_depth", "min_weight", "blur_samples", "seed"};
 const Keys kAmbientKeys = {"color", "intensity"};
 const Keys kMaterialKeys = {
@@ -76,14 +77,27 @@ struct LightInfo {
   Keys required;
 };
 
-const std::array<LightInfo, 3> kLights{{
+const std::array<LightInfo, 4> kLights{{
     {"directional", LightType::Directional, {"direction", "color", "intensity"}, {"direction"}},
     {"point", LightType::Point, {"position", "color", "intensity", "attenuation"}, {"position"}},
     {"spot",
      LightType::Spot,
      {"position", "direction", "color", "intensity", "attenuation", "exponent"},
      {"position", "direction"}},
+    // Plus the geometry keys of its shape (kAreaShapes). `shape` is required, but parseAreaLight
+    // reports it missing, with the list of shapes.
+    {"area", LightType::Area, {"shape", "color", "intensity", "attenuation", "samples"}, {}},
 }};
+
+// The shapes an area light may take: the objects of the same name, with their geometry keys.
+const Keys kAreaShapes = {"rectangle", "disk", "sphere"};
+
+const ShapeInfo* shapeInfo(std::string_view name) {
+  for (const ShapeInfo& s : kShapes) {
+    if (s.name == name) return &s;
+  }
+  return nullptr;
+}
 
 bool contains(const Keys& names, std::string_view key) {
   for (std::string_view n : names) {
@@ -246,6 +260,10 @@ class Parser {
   void parseObjects(const Value& v, SceneDescription& scene);
   void parseObject(const Value& v, std::size_t index, SceneDescription& scene);
   void parseTransform(const Value& v, ObjectDescription& object);
+  // Reads geometry key `e` of a shape of `type` into `object` (objects and area lights alike).
+  void parseGeometryKey(const Entry& e, const Value& value, ShapeType type,
+                        ObjectDescription& object);
+  void parseAreaLight(const Value& v, const Fields& fields, LightDescription& light);
   void parseLights(const Value& v, SceneDescription& scene);
   void parseLight(const Value& v, std::size_t index, SceneDescription& scene);
 
@@ -649,6 +667,17 @@ void Parser::parseImage(const Value& v, SceneDescription& scene) {
         if (ge.key == "color") grid.color = color(gv);
       }
       image.grid = grid;
+    } else if (e.key == "adaptive") {
+      if (!expectMapping(value, "a mapping {max_samples, threshold}")) continue;
+      AdaptiveDescription adaptive;
+      adaptive.where = at(value.node);
+      const Fields af = readFields(value.node, "in image.adaptive", &kAdaptiveKeys);
+      for (const Entry& ae : af.entries) {
+        const Value av = valueOf(ae, "image.adaptive");
+        if (ae.key == "max_samples") adaptive.maxSamples = integer(av);
+        if (ae.key == "threshold") adaptive.threshold = number(av);
+      }
+      image.adaptive = adaptive;
     }
   }
   scene.image = std::move(image);
@@ -798,34 +827,7 @@ void Parser::parseObject(const Value& v, std::size_t index, SceneDescription& sc
     const Value value = valueOf(e, owner);
     const std::string& k = e.key;
     if (k == "type" || e.unknown) continue;  // unknown keys are already reported
-    if (k == "center") object.center = point3(value);
-    if (k == "point") object.point = point3(value);
-    if (k == "origin") object.origin = point3(value);
-    if (k == "base") object.base = point3(value);
-    if (k == "corner") object.corner = point3(value);
-    if (k == "min") object.min = point3(value);
-    if (k == "max") object.max = point3(value);
-    if (k == "normal") object.normal = vec3(value);
-    if (k == "axis") object.axis = vec3(value);
-    if (k == "radius") object.radius = number(value);
-    if (k == "height") object.height = number(value);
-    if (k == "edges") object.edges = vectorList(value, 2);
-    if (k == "points") object.points = pointList(value, 3, 3);
-    if (k == "file") object.file = text(value);
-    if (k == "smooth") object.smooth = boolean(value);
-    if (k == "vertices") {
-      switch (info->type) {
-        case ShapeType::Triangle:
-          object.vertices = pointList(value, 3, 3);
-          break;
-        case ShapeType::Quadrangle:
-          object.vertices = pointList(value, 4, 4);
-          break;
-        default:
-          object.vertices = pointList(value, 3, std::numeric_limits<std::size_t>::max());
-          break;
-      }
-    }
+    parseGeometryKey(e, value, info->type, object);
     if (k == "material") {
       if (value.node.isScalar()) {
         object.materialName = text(value);
@@ -842,6 +844,39 @@ void Parser::parseObject(const Value& v, std::size_t index, SceneDescription& sc
   }
   object.complete = errorCount() == errorsBefore;
   scene.objects.push_back(std::move(object));
+}
+
+void Parser::parseGeometryKey(const Entry& e, const Value& value, ShapeType type,
+                              ObjectDescription& object) {
+  const std::string& k = e.key;
+  if (k == "center") object.center = point3(value);
+  if (k == "point") object.point = point3(value);
+  if (k == "origin") object.origin = point3(value);
+  if (k == "base") object.base = point3(value);
+  if (k == "corner") object.corner = point3(value);
+  if (k == "min") object.min = point3(value);
+  if (k == "max") object.max = point3(value);
+  if (k == "normal") object.normal = vec3(value);
+  if (k == "axis") object.axis = vec3(value);
+  if (k == "radius") object.radius = number(value);
+  if (k == "height") object.height = number(value);
+  if (k == "edges") object.edges = vectorList(value, 2);
+  if (k == "points") object.points = pointList(value, 3, 3);
+  if (k == "file") object.file = text(value);
+  if (k == "smooth") object.smooth = boolean(value);
+  if (k == "vertices") {
+    switch (type) {
+      case ShapeType::Triangle:
+        object.vertices = pointList(value, 3, 3);
+        break;
+      case ShapeType::Quadrangle:
+        object.vertices = pointList(value, 4, 4);
+        break;
+      default:
+        object.vertices = pointList(value, 3, std::numeric_limits<std::size_t>::max());
+        break;
+    }
+  }
 }
 
 void Parser::parseTransform(const Value& v, ObjectDescription& object) {
@@ -935,7 +970,7 @@ void Parser::parseLights(const Value& v, SceneDescription& scene) {
 }
 
 void Parser::parseLight(const Value& v, std::size_t index, SceneDescription& scene) {
-  if (!expectMapping(v, "a mapping with a 'type' (directional, point or spot)")) return;
+  if (!expectMapping(v, "a mapping with a 'type' (directional, point, spot or area)")) return;
   const std::size_t errorsBefore = errorCount();
   LightDescription light;
   light.index = index;
@@ -977,8 +1012,18 @@ void Parser::parseLight(const Value& v, std::size_t index, SceneDescription& sce
 
   Keys known{"type"};
   known.insert(known.end(), info->keys.begin(), info->keys.end());
+  if (info->type == LightType::Area) {
+    // Every geometry key of every area shape is known here, so that a key of another shape gets
+    // its own message (parseAreaLight) rather than a plain "unknown key".
+    for (std::string_view shape : kAreaShapes) {
+      for (std::string_view key : shapeInfo(shape)->keys) {
+        if (!contains(known, key)) known.push_back(key);
+      }
+    }
+  }
   const Fields fields = readFields(v.node, "in " + owner, &known);
   requireKeys(fields, info->required, light.where, owner);
+  if (info->type == LightType::Area) parseAreaLight(v, fields, light);
   for (const Entry& e : fields.entries) {
     if (e.unknown) continue;  // already reported (another light type's key)
     const Value value = valueOf(e, owner);
@@ -987,6 +1032,7 @@ void Parser::parseLight(const Value& v, std::size_t index, SceneDescription& sce
     if (e.key == "position") light.position = point3(value);
     if (e.key == "direction") light.direction = vec3(value);
     if (e.key == "exponent") light.exponent = number(value);
+    if (e.key == "samples") light.samples = integer(value);
     if (e.key == "attenuation") {
       if (auto t = triple(value, "[kc, kl, kq]")) {
         light.attenuation = Located<std::array<double, 3>>{*t, value.where};
@@ -994,7 +1040,67 @@ void Parser::parseLight(const Value& v, std::size_t index, SceneDescription& sce
     }
   }
   light.complete = errorCount() == errorsBefore;
+  if (light.surface) light.surface->complete = light.complete;
   scene.lights.push_back(std::move(light));
+}
+
+// An area light's `shape` and the geometry keys of that shape, read exactly as the object of that
+// shape reads them; the geometry keys of the other shapes are errors.
+void Parser::parseAreaLight(const Value& v, const Fields& fields, LightDescription& light) {
+  const std::string shapeList = fmt::format("{}", fmt::join(kAreaShapes, ", "));
+  const ShapeInfo* info = nullptr;
+  const Entry* shapeEntry = fields.find("shape");
+  if (!shapeEntry) {
+    // As requireKeys: a misspelt `shape` was already reported as unknown, with the suggestion.
+    bool misspelt = false;
+    for (const Entry& e : fields.entries) {
+      misspelt = misspelt || (e.unknown && closestName(e.key, Keys{"shape"}) == "shape");
+    }
+    if (!misspelt) {
+      error(light.where,
+            fmt::format("area light is missing required key 'shape' (one of: {})", shapeList));
+    }
+  } else {
+    const Value value = valueOf(*shapeEntry, "area light");
+    if (!value.node.isScalar()) {
+      error(value.where, fmt::format("area light.shape: expected one of {}, got {}", shapeList,
+                                     describe(value.node)));
+    } else {
+      light.shape = Located<std::string>{value.node.scalar(), value.where};
+      if (contains(kAreaShapes, light.shape->value)) {
+        info = shapeInfo(light.shape->value);
+      } else {
+        error(value.where, fmt::format("unknown area light shape {}; expected one of: {}{}",
+                                       inQuotes(light.shape->value), shapeList,
+                                       didYouMean(light.shape->value, kAreaShapes)));
+      }
+    }
+  }
+  if (!info) return;  // without a shape its geometry keys cannot be checked
+
+  ObjectDescription surface;
+  surface.type = info->type;
+  surface.typeName = "area light";
+  surface.index = light.index;
+  surface.where = at(v.node);
+  const std::string owner = std::string(info->name) + " area light";
+  requireKeys(fields, info->required, light.where, owner);
+  for (const Entry& e : fields.entries) {
+    if (e.unknown) continue;
+    std::vector<std::string_view> owners;  // the area shapes that have this geometry key
+    for (std::string_view shape : kAreaShapes) {
+      if (contains(shapeInfo(shape)->keys, e.key)) owners.push_back(shape);
+    }
+    if (owners.empty()) continue;  // not a geometry key: parseLight reads it
+    if (!contains(info->keys, e.key)) {
+      error(e.keyWhere, fmt::format("'{}' is a key of a {} area light, not of a {}; a {} takes {}",
+                                    e.key, fmt::join(owners, " or "), info->name, info->name,
+                                    fmt::join(info->keys, ", ")));
+      continue;
+    }
+    parseGeometryKey(e, valueOf(e, "area light"), info->type, surface);
+  }
+  light.surface = std::move(surface);
 }
 
 // yaml-cpp's syntax messages in plain words.
@@ -1056,6 +1162,12 @@ ParseResult parseScene(std::string_view text, const std::string& file,
     if (where.line == 0) where = parser.start();
     if (e.tooDeep) {
       parser.error(where, "syntax error: lists or mappings are nested too deeply");
+      return result;
+    }
+    if (e.refused) {
+      // An alias bomb, too many values, an alias inside its own anchor: not a syntax error, and
+      // the reader's message is already in plain words.
+      parser.error(where, e.what());
       return result;
     }
     std::string message = describeSyntaxError(e.what());

@@ -365,8 +365,8 @@ TEST(SceneParser, MeshKeyErrors) {
 }
 
 TEST(SceneParser, UnknownTypesListTheKnownOnes) {
-  expectOneError(std::string(kMinimal) + "lights:\n  - {type: area, position: [0, 0, 0]}\n", 4, 12,
-                 "unknown light type 'area'; expected one of: directional, point, spot");
+  expectOneError(std::string(kMinimal) + "lights:\n  - {type: laser, position: [0, 0, 0]}\n", 4, 12,
+                 "unknown light type 'laser'; expected one of: directional, point, spot, area");
   expectOneError(std::string(kMinimal) + "objects:\n  - {type: sphre}\n", 4, 12,
                  "unknown object type 'sphre'; expected one of: sphere, plane, triangle, polygon, "
                  "rectangle, quadrangle, tube, cylinder, box, disk, mesh (did you mean 'sphere'?)");
@@ -377,6 +377,188 @@ TEST(SceneParser, UnknownTypesListTheKnownOnes) {
       "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
       "image: {width: 4, height: 3, encoding: srbg}\n",
       2, 40, "image.encoding must be srgb or linear, got 'srbg' (did you mean 'srgb'?)");
+}
+
+// The column (1-based) where `token` first starts in `line`: positions written as what they point
+// at rather than as bare numbers.
+int columnOf(const std::string& line, const std::string& token) {
+  const std::size_t at = line.find(token);
+  EXPECT_NE(at, std::string::npos) << token << " not in " << line;
+  return static_cast<int>(at) + 1;
+}
+
+TEST(SceneParser, AreaLightKeysOfEachShape) {
+  const ParseResult r = parseScene(
+      std::string(kMinimal) +
+          "lights:\n"
+          "  - type: area\n"
+          "    shape: rectangle\n"
+          "    corner: [-1, 4, -1]\n"
+          "    edges: [[2, 0, 0], [0, 0, 3]]\n"
+          "    color: [1, 0.9, 0.8]\n"
+          "    intensity: 2\n"
+          "    attenuation: [1, 0, 0.01]\n"
+          "    samples: 32\n"
+          "  - {type: area, shape: disk, center: [0, 5, 0], normal: [0, -2, 0], radius: 0.5}\n"
+          "  - {type: area, shape: sphere, center: [1, 2, 3], radius: 0.25, samples: 4}\n",
+      "test.yaml");
+  ASSERT_FALSE(r.hasErrors()) << r.diagnostics[0].format();
+  const std::vector<LightDescription>& lights = r.description.lights;
+  ASSERT_EQ(lights.size(), 3u);
+
+  const LightDescription& rect = lights[0];
+  EXPECT_EQ(rect.type, LightType::Area);
+  EXPECT_EQ(rect.typeName, "area");
+  ASSERT_TRUE(rect.shape && rect.surface && rect.samples && rect.intensity && rect.attenuation);
+  EXPECT_EQ(rect.shape->value, "rectangle");
+  EXPECT_EQ(rect.shape->where.line, 5);
+  EXPECT_EQ(rect.shape->where.column, 12);
+  EXPECT_EQ(rect.surface->type, ShapeType::Rectangle);
+  EXPECT_TRUE(rect.surface->complete);
+  ASSERT_TRUE(rect.surface->corner && rect.surface->edges);
+  EXPECT_EQ(rect.surface->corner->value, (Point3{-1, 4, -1}));
+  EXPECT_EQ(rect.surface->corner->where.line, 6);
+  EXPECT_EQ(rect.surface->edges->value, (std::vector<Vec3>{{2, 0, 0}, {0, 0, 3}}));
+  EXPECT_EQ(rect.surface->edges->where.line, 7);
+  EXPECT_EQ(rect.surface->edges->where.column, 12);
+  EXPECT_FALSE(rect.surface->radius);
+  EXPECT_EQ(rect.samples->value, 32);
+  EXPECT_EQ(rect.samples->where.line, 11);
+  EXPECT_EQ(rect.intensity->value, 2);
+  EXPECT_EQ(rect.attenuation->value, (std::array<double, 3>{1, 0, 0.01}));
+
+  const LightDescription& disk = lights[1];
+  ASSERT_TRUE(disk.surface);
+  EXPECT_EQ(disk.surface->type, ShapeType::Disk);
+  ASSERT_TRUE(disk.surface->center && disk.surface->normal && disk.surface->radius);
+  EXPECT_EQ(disk.surface->normal->value, (Vec3{0, -2, 0}));  // normalised by the builder
+  EXPECT_EQ(disk.surface->radius->value, 0.5);
+  EXPECT_FALSE(disk.samples);  // default: the builder's AreaLight::samples
+  EXPECT_FALSE(disk.color);
+
+  const LightDescription& sphere = lights[2];
+  ASSERT_TRUE(sphere.surface && sphere.samples);
+  EXPECT_EQ(sphere.surface->type, ShapeType::Sphere);
+  EXPECT_EQ(sphere.surface->center->value, (Point3{1, 2, 3}));
+  EXPECT_EQ(sphere.surface->radius->value, 0.25);
+  EXPECT_EQ(sphere.samples->value, 4);
+}
+
+TEST(SceneParser, AreaLightKeyErrors) {
+  const std::string lights = std::string(kMinimal) + "lights:\n";
+  const auto expectLightError = [&](const std::string& light, const std::string& token,
+                                    const std::string& fragment) {
+    const std::string line = "  - " + light;
+    expectOneError(lights + line + "\n", 4, token.empty() ? 5 : columnOf(line, token), fragment);
+  };
+  expectLightError("{type: area, center: [0, 1, 0], radius: 1}", "",
+                   "area light is missing required key 'shape' (one of: rectangle, disk, sphere)");
+  // A misspelt shape is one error: the unknown key, with the suggestion.
+  expectLightError("{type: area, shap: disk, center: [0, 1, 0], radius: 1}", "shap",
+                   "unknown key 'shap' in area light; expected one of: shape, color, intensity, "
+                   "attenuation, samples, corner, edges, center, normal, radius (did you mean "
+                   "'shape'?)");
+  expectLightError("{type: area, shape: square, corner: [0, 1, 0]}", "square",
+                   "unknown area light shape 'square'; expected one of: rectangle, disk, sphere");
+  expectLightError("{type: area, shape: spere, center: [0, 1, 0], radius: 1}", "spere",
+                   "(did you mean 'sphere'?)");
+  expectLightError(
+      "{type: area, shape: [disk], center: [0, 1, 0], radius: 1}", "[disk]",
+      "area light.shape: expected one of rectangle, disk, sphere, got a list of 1 item");
+  // Another shape's geometry key is an error naming the shapes it belongs to.
+  expectLightError(
+      "{type: area, shape: rectangle, corner: [0, 1, 0], edges: [[1, 0, 0], [0, 0, 1]], "
+      "radius: 1}",
+      "radius",
+      "'radius' is a key of a disk or sphere area light, not of a rectangle; a rectangle takes "
+      "corner, edges");
+  expectLightError("{type: area, shape: sphere, center: [0, 1, 0], radius: 1, normal: [0, 1, 0]}",
+                   "normal", "'normal' is a key of a disk area light, not of a sphere");
+  expectLightError(
+      "{type: area, shape: disk, center: [0, 1, 0], normal: [0, 1, 0], radius: 1, corner: [0, 0, "
+      "0]}",
+      "corner", "'corner' is a key of a rectangle area light, not of a disk");
+  // Keys of no area light: unknown, with a suggestion.
+  expectLightError("{type: area, shape: sphere, center: [0, 1, 0], radius: 1, sampels: 4}",
+                   "sampels",
+                   "unknown key 'sampels' in area light; expected one of: shape, color, "
+                   "intensity, attenuation, samples");
+  expectLightError("{type: area, shape: sphere, center: [0, 1, 0], radius: 1, sampels: 4}",
+                   "sampels", "(did you mean 'samples'?)");
+  const std::vector<Diagnostic> positioned =
+      errorsOf(lights + "  - {type: area, shape: sphere, position: [0, 1, 0], radius: 1}\n");
+  ASSERT_EQ(positioned.size(), 2u);
+  // In file order: the light (missing center), then its unknown key.
+  EXPECT_EQ(positioned[0].message, "sphere area light is missing required key 'center'");
+  EXPECT_EQ(positioned[0].where.column, 5);
+  EXPECT_THAT(positioned[1].message, HasSubstr("unknown key 'position' in area light"));
+  EXPECT_EQ(positioned[1].where.column, 33);
+  // Missing geometry, reported at the light.
+  expectLightError("{type: area, shape: rectangle, corner: [0, 1, 0]}", "",
+                   "rectangle area light is missing required key 'edges'");
+  expectLightError("{type: area, shape: disk, center: [0, 1, 0], normal: [0, 1, 0]}", "",
+                   "disk area light is missing required key 'radius'");
+  // Types of the values, as for the object of that shape.
+  expectLightError("{type: area, shape: rectangle, corner: [0, 1, 0], edges: [[1, 0, 0]]}",
+                   "[[1, 0, 0]]",
+                   "area light.edges: expected a list of 2 vectors [[x, y, z], ...], got a list of "
+                   "1 item");
+  expectLightError("{type: area, shape: sphere, center: [0, 1, 0], radius: big}", "big",
+                   "area light.radius: expected a number, got 'big'");
+  expectLightError("{type: area, shape: sphere, center: [0, 1, 0], radius: 1, samples: 2.5}", "2.5",
+                   "area light.samples: expected a whole number, got 2.5");
+  expectLightError("{type: area, shape: sphere, center: [0, 1, .nan], radius: 1}", ".nan",
+                   "area light.center[2] must be a finite number, got .nan");
+  // A point light's keys stay unknown to area lights and the other way round.
+  expectOneError(lights + "  - {type: point, position: [0, 0, 0], samples: 4}\n", 4, 40,
+                 "unknown key 'samples' in point light");
+}
+
+TEST(SceneParser, AdaptiveSamplingKeys) {
+  const std::string camera = "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n";
+  const ParseResult r = parseScene(camera +
+                                       "image: {width: 4, height: 3, samples: 2,\n"
+                                       "        adaptive: {max_samples: 128, threshold: 0.02}}\n",
+                                   "test.yaml");
+  ASSERT_FALSE(r.hasErrors()) << r.diagnostics[0].format();
+  ASSERT_TRUE(r.description.image && r.description.image->adaptive);
+  const AdaptiveDescription& a = *r.description.image->adaptive;
+  ASSERT_TRUE(a.maxSamples && a.threshold);
+  EXPECT_EQ(a.maxSamples->value, 128);
+  EXPECT_EQ(a.maxSamples->where.line, 3);
+  EXPECT_EQ(a.maxSamples->where.column, 33);
+  EXPECT_EQ(a.threshold->value, 0.02);
+  EXPECT_EQ(a.where.line, 3);
+  EXPECT_EQ(a.where.column, 19);
+
+  // Both keys are optional; absent ones are left to AdaptiveSampling's defaults.
+  const ParseResult empty =
+      parseScene(camera + "image: {width: 4, height: 3, adaptive: {}}\n", "test.yaml");
+  ASSERT_FALSE(empty.hasErrors()) << empty.diagnostics[0].format();
+  ASSERT_TRUE(empty.description.image->adaptive);
+  EXPECT_FALSE(empty.description.image->adaptive->maxSamples);
+  EXPECT_FALSE(empty.description.image->adaptive->threshold);
+  EXPECT_FALSE(parseScene(std::string(kMinimal), "test.yaml").description.image->adaptive);
+
+  const std::string image = "image: {width: 4, height: 3, adaptive: ";
+  const auto expectAdaptiveError = [&](const std::string& adaptive, const std::string& token,
+                                       const std::string& fragment) {
+    const std::string line = image + adaptive + "}";
+    expectOneError(camera + line + "\n", 2, columnOf(line, token), fragment);
+  };
+  expectAdaptiveError("{max_sample: 8}", "max_sample",
+                      "unknown key 'max_sample' in image.adaptive; expected one of: max_samples, "
+                      "threshold (did you mean 'max_samples'?)");
+  expectAdaptiveError("{max_samples: 8.5}", "8.5",
+                      "image.adaptive.max_samples: expected a whole number, got 8.5");
+  expectAdaptiveError("{threshold: low}", "low",
+                      "image.adaptive.threshold: expected a number, got 'low'");
+  expectAdaptiveError("{threshold: .inf}", ".inf",
+                      "image.adaptive.threshold must be a finite number, got .inf");
+  expectAdaptiveError("8", "8",
+                      "image.adaptive: expected a mapping {max_samples, threshold}, got '8'");
+  expectAdaptiveError("{max_samples: 8, max_samples: 9}", "max_samples: 9",
+                      "duplicate key 'max_samples' in image.adaptive");
 }
 
 TEST(SceneParser, TransformSteps) {
