@@ -435,6 +435,15 @@ const std::vector<BrokenScene> kBrokenScenes{
     {"objects_not_a_list.yaml", "9:10", {"objects"}},
     {"negative_min_weight.yaml", "10:15", {"min_weight"}},
     {"grid_interval_zero.yaml", "9:21", {"interval"}},
+    {"area_light_missing_shape.yaml", "12:5", {"shape", "rectangle, disk, sphere"}},
+    {"area_light_key_of_another_shape.yaml", "16:5", {"radius", "not of a rectangle"}},
+    {"area_light_edges_not_perpendicular.yaml", "15:12", {"perpendicular"}},
+    {"area_light_zero_normal.yaml", "15:13", {"normal", "non-zero"}},
+    {"area_light_radius_zero.yaml", "12:61", {"radius", "> 0"}},
+    {"area_light_samples_zero.yaml", "12:75", {"samples"}},
+    {"adaptive_max_below_samples.yaml", "10:28", {"max_samples", "image.samples"}},
+    {"adaptive_threshold_zero.yaml", "9:43", {"threshold"}},
+    {"aperture_without_focus.yaml", "6:13", {"focus_distance", "look_at"}},
 };
 
 TEST_F(Cli, BrokenScenesExitTwoNamingFileLineAndColumn) {
@@ -750,6 +759,269 @@ TEST_F(Cli, ProgressIsABarRedrawnInPlaceOnATerminal) {
   EXPECT_FALSE(std::regex_search(err, std::regex("glint: [0-9]+% \\(elapsed"))) << "no log lines";
   EXPECT_TRUE(contains(err, "ETA")) << err;
   EXPECT_TRUE(contains(err, "Mrays/s")) << err;
+}
+
+// --- memory budget ------------------------------------------------------------------------
+
+TEST_F(Cli, MaxMemoryAcceptsUnitsAndRefusesTooSmallABudget) {
+  // small.yaml's film: 32 × 24 pixels × 24 bytes = 18 KiB.
+  for (const char* size : {"1G", "1.5GiB", "512M", "4g", "19K", "100000", "20kb", "1 MiB"}) {
+    const RunResult r = run({"render", small(), "-o", "out.png", "--quiet", "--max-memory", size});
+    EXPECT_EQ(r.status, 0) << size << ": " << r.err;
+  }
+  // The scene's own image is refused by the loader, at the image's place in the file.
+  RunResult r = run({"render", small(), "-o", "small.png", "--max-memory", "10K"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "small.yaml:13:3")) << r.err;
+  EXPECT_TRUE(contains(r.err, "needs 18.0 KiB")) << r.err;
+  EXPECT_TRUE(contains(r.err, "memory budget of 10.0 KiB")) << r.err;
+  // An image enlarged on the command line is refused by the command line, naming the options.
+  r = run({"render", small(), "-o", "small.png", "--max-memory", "30K", "--width", "64"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "--width 64 --max-memory 30K refused")) << r.err;
+  EXPECT_TRUE(contains(r.err, "needs 72.0 KiB")) << r.err;
+  EXPECT_TRUE(contains(r.err, "memory budget of 30.0 KiB")) << r.err;
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{"out.png"});
+}
+
+TEST_F(Cli, MaxMemoryWithABadSizeIsAnArgumentError) {
+  for (const char* size : {"abc", "0", "-5", "12Q", "1.5.2G", "", "G", "0.1", "99999999999T"}) {
+    const RunResult r = run({"render", small(), "-o", "out.png", "--max-memory", size});
+    EXPECT_EQ(r.status, 2) << size;
+    EXPECT_TRUE(contains(r.err, "--max-memory")) << size << ": " << r.err;
+  }
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
+TEST_F(Cli, CheckpointCopiesCountAgainstTheMemoryBudget) {
+  // 18 KiB fits in 30 KiB, the film and its checkpoint copy (36 KiB) do not.
+  ASSERT_EQ(run({"render", small(), "-o", "out.png", "--quiet", "--max-memory", "30K"}).status, 0);
+  const RunResult r =
+      run({"render", small(), "-o", "out.png", "--max-memory", "30K", "--checkpoint", "run.ckpt"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "for checkpointing")) << r.err;
+}
+
+// --- checkpoint and resume ------------------------------------------------------------------
+
+class CliCheckpoint : public Cli {
+ protected:
+  // small.yaml at 128x96 (48 tiles): long enough to interrupt, short enough for a test.
+  std::vector<std::string> renderArgs(const std::vector<std::string>& extra) const {
+    std::vector<std::string> args{"render", scene(), "--width", "128"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  }
+  std::string scene() const { return (work_ / "scene.yaml").string(); }
+  void SetUp() override {
+    Cli::SetUp();
+    fs::copy_file(kScenes / "small.yaml", work_ / "scene.yaml");
+  }
+
+  // Starts a render with --checkpoint, sends SIGINT once it has reported progress (some tiles
+  // done), and returns how it ended.
+  RunResult interruptedRender(const std::vector<std::string>& extra) {
+    const pid_t pid = start(renderArgs(extra));
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
+    std::string err;
+    while (std::chrono::steady_clock::now() < deadline) {
+      err = readFile(root_ / "capture" / "stderr");
+      if (std::regex_search(err, std::regex(R"(glint: [1-9][0-9]?% )"))) break;
+      std::this_thread::sleep_for(1ms);
+    }
+    kill(pid, SIGINT);
+    return finish(pid, 30s);
+  }
+};
+
+TEST_F(CliCheckpoint, SigintSavesACheckpointAndResumeGivesTheSameBytes) {
+  ASSERT_EQ(run(renderArgs({"-o", "reference.ppm", "--quiet"})).status, 0);
+  const RunResult stopped =
+      interruptedRender({"-o", "out.ppm", "--checkpoint", "run.ckpt", "--threads", "1"});
+  ASSERT_EQ(stopped.status, 130) << "the render ended before the signal?\n" << stopped.err;
+  const std::regex saved(R"(glint: interrupted; (\d+) of 48 tiles saved to 'run.ckpt')");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(stopped.err, m, saved)) << stopped.err;
+  const int tilesSaved = std::stoi(m[1]);
+  EXPECT_GT(tilesSaved, 0);
+  EXPECT_LT(tilesSaved, 48);
+  EXPECT_TRUE(contains(stopped.err, "--resume run.ckpt")) << stopped.err;
+  EXPECT_EQ(filesIn(work_), (std::set<std::string>{"reference.ppm", "run.ckpt", "scene.yaml"}))
+      << "no partial image, no temporary file";
+  EXPECT_EQ(readFile(work_ / "run.ckpt").substr(0, 8), "GLINTCKP");
+
+  // A resumed render keeps checkpointing into the same file, so it can be interrupted again.
+  const RunResult again = interruptedRender({"-o", "out.ppm", "--resume", "run.ckpt"});
+  ASSERT_EQ(again.status, 130) << again.err;
+  ASSERT_TRUE(std::regex_search(again.err, m, saved)) << again.err;
+  const int tilesSavedAgain = std::stoi(m[1]);
+  EXPECT_GE(tilesSavedAgain, tilesSaved);
+  EXPECT_FALSE(fs::exists(work_ / "out.ppm"));
+
+  // Resumed on another thread count; the checkpoint goes once the image is written.
+  const RunResult resumed = run(renderArgs({"-o", "out.ppm", "--resume", "run.ckpt"}));
+  ASSERT_EQ(resumed.status, 0) << resumed.err;
+  EXPECT_TRUE(contains(resumed.err,
+                       std::to_string(tilesSavedAgain) + " of 48 tiles resumed from 'run.ckpt'"))
+      << resumed.err;
+  EXPECT_TRUE(readFile(work_ / "out.ppm") == readFile(work_ / "reference.ppm"))
+      << "the resumed image differs from the uninterrupted one";
+  EXPECT_EQ(filesIn(work_), (std::set<std::string>{"out.ppm", "reference.ppm", "scene.yaml"}));
+}
+
+TEST_F(CliCheckpoint, ResumeRefusesAMismatchedCorruptOrMissingCheckpoint) {
+  const RunResult stopped = interruptedRender({"-o", "out.ppm", "--checkpoint", "run.ckpt"});
+  ASSERT_EQ(stopped.status, 130) << stopped.err;
+  const std::string checkpoint = readFile(work_ / "run.ckpt");
+  ASSERT_FALSE(checkpoint.empty());
+
+  const auto refused = [&](const std::vector<std::string>& extra, const std::string& reason) {
+    std::vector<std::string> all{"-o", "out.ppm", "--resume", "run.ckpt"};
+    all.insert(all.end(), extra.begin(), extra.end());
+    const RunResult r = run(renderArgs(all));
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_TRUE(contains(r.err, reason)) << reason << " missing in:\n" << r.err;
+    EXPECT_FALSE(fs::exists(work_ / "out.ppm"));
+  };
+  refused({"--samples", "2"},
+          "cannot resume from 'run.ckpt': it was made with samples per "
+          "pixel 4, this render has 2");
+  refused({"--seed", "8"}, "it was made with seed 7, this render has 8");
+  refused({"--crop", "0,0,80,60"}, "region the whole image, this render has --crop 0,0,80,60");
+  EXPECT_EQ(readFile(work_ / "run.ckpt"), checkpoint) << "a refused resume keeps the checkpoint";
+
+  // The scene file changed (a comment is enough: the fingerprint covers its bytes).
+  writeFile(work_ / "scene.yaml", readFile(kScenes / "small.yaml") + "# changed\n");
+  refused({}, "the scene file");
+  fs::copy_file(kScenes / "small.yaml", work_ / "scene.yaml", fs::copy_options::overwrite_existing);
+
+  writeFile(work_ / "run.ckpt", checkpoint.substr(0, checkpoint.size() / 2));
+  refused({}, "cannot resume: checkpoint 'run.ckpt' is ");
+  std::string flipped = checkpoint;
+  flipped[flipped.size() / 2] = static_cast<char>(flipped[flipped.size() / 2] ^ 4);
+  writeFile(work_ / "run.ckpt", flipped);
+  refused({}, "checksum");
+  writeFile(work_ / "run.ckpt", "P6\n1 1\n255\nabc");
+  refused({}, "'run.ckpt' is not a glint checkpoint");
+  fs::remove(work_ / "run.ckpt");
+  refused({}, "'run.ckpt': no such file");
+}
+
+TEST_F(CliCheckpoint, AFailedImageWriteKeepsTheFinishedRenderInTheCheckpoint) {
+  fs::create_directory(work_ / "images");
+  const pid_t pid = start(renderArgs({"-o", "images/out.ppm", "--checkpoint", "run.ckpt"}));
+  // The output folder disappears while the render runs: writing the image fails (exit 1).
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (!contains(readFile(root_ / "capture" / "stderr"), "%") &&
+         std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(1ms);
+  fs::remove(work_ / "images");
+  const RunResult failed = finish(pid, 30s);
+  ASSERT_EQ(failed.status, 1) << failed.err;
+  EXPECT_TRUE(contains(failed.err, "the finished render is saved in 'run.ckpt'")) << failed.err;
+  fs::create_directory(work_ / "images");
+  const RunResult written = run(renderArgs({"-o", "images/out.ppm", "--resume", "run.ckpt"}));
+  ASSERT_EQ(written.status, 0) << written.err;
+  EXPECT_TRUE(contains(written.err, "48 of 48 tiles resumed from 'run.ckpt'")) << written.err;
+  EXPECT_TRUE(contains(written.err, "rays: 0 camera")) << "nothing rendered again: " << written.err;
+  EXPECT_FALSE(fs::exists(work_ / "run.ckpt"));
+  EXPECT_EQ(readPpm(work_ / "images" / "out.ppm").width, 128);
+}
+
+TEST_F(CliCheckpoint, ExistingCheckpointIsNotOverwrittenWithoutResume) {
+  writeFile(work_ / "run.ckpt", "precious work");
+  const RunResult r = run(renderArgs({"-o", "out.ppm", "--checkpoint", "run.ckpt"}));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "already exists; continue it with --resume run.ckpt")) << r.err;
+  EXPECT_EQ(readFile(work_ / "run.ckpt"), "precious work");
+  EXPECT_FALSE(fs::exists(work_ / "out.ppm"));
+  // Nor can the checkpoint be the output image.
+  const RunResult same = run(renderArgs({"-o", "out.ppm", "--checkpoint", "out.ppm"}));
+  EXPECT_EQ(same.status, 2);
+  EXPECT_TRUE(contains(same.err, "cannot be the output image")) << same.err;
+}
+
+TEST_F(CliCheckpoint, FinishedRenderLeavesNoCheckpoint) {
+  const RunResult r = run({"render", small(), "-o", "out.png", "--checkpoint", "run.ckpt"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(filesIn(work_), (std::set<std::string>{"out.png", "scene.yaml"}));
+  const RunResult missingFolder =
+      run({"render", small(), "-o", "out.png", "--checkpoint", "nowhere/run.ckpt"});
+  EXPECT_EQ(missingFolder.status, 2);
+  EXPECT_TRUE(contains(missingFolder.err, "the folder 'nowhere' does not exist"))
+      << missingFolder.err;
+}
+
+TEST_F(Cli, CheckCountsAreaLights) {
+  std::string text = readFile(kScenes / "small.yaml");
+  text +=
+      "  - { type: area, shape: disk, center: [0, 3, 0], normal: [0, -1, 0], radius: 0.5,\n"
+      "      color: [1, 1, 1], intensity: 2, samples: 4 }\n";
+  writeFile(root_ / "area.yaml", text);
+  const RunResult r = run({"check", (root_ / "area.yaml").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "lights:    3 (1 area) + ambient")) << r.out;
+}
+
+TEST_F(Cli, NonFiniteSamplesAreCountedWithTheirFirstPixel) {
+  // Two lights of 1.7e308 each: their sum overflows to infinity wherever both reach a surface.
+  std::string text = readFile(kScenes / "small.yaml");
+  for (const std::string intensity : {"intensity: 1.2 }", "intensity: 0.4 }"}) {
+    ASSERT_NE(text.find(intensity), std::string::npos);
+    text.replace(text.find(intensity), intensity.size(), "intensity: 1.7e308 }");
+  }
+  writeFile(root_ / "overflow.yaml", text);
+  const std::regex line(
+      R"(glint: (\d+) NaN/inf samples replaced by black, first at pixel \((\d+), (\d+)\))");
+  std::string first;
+  for (const char* threads : {"1", "2"}) {
+    const RunResult r = run({"render", (root_ / "overflow.yaml").string(), "-o", "out.png",
+                             "--threads", threads, "--stats"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(r.err, m, line)) << r.err;
+    EXPECT_GT(std::stoi(m[1]), 0);
+    EXPECT_TRUE(contains(r.err, "non-finite samples: " + m[1].str())) << r.err;
+    if (first.empty()) first = m[0];
+    EXPECT_EQ(m[0], first) << "the count and first pixel do not depend on the thread count";
+  }
+  const RunResult plain = run({"render", small(), "-o", "out.png"});
+  EXPECT_FALSE(contains(plain.err, "NaN")) << plain.err;
+}
+
+// --- adaptive sampling in the summaries --------------------------------------------------------
+
+TEST_F(Cli, AdaptiveSamplingIsReportedAndSamplesRaisesItsMaximum) {
+  std::string text = readFile(kScenes / "small.yaml");
+  const std::string fixed = "  samples: 4\n";
+  ASSERT_NE(text.find(fixed), std::string::npos);
+  text.replace(text.find(fixed), fixed.size(),
+               fixed + "  adaptive: { max_samples: 8, threshold: 0.05 }\n");
+  writeFile(root_ / "adaptive.yaml", text);
+  const std::string scene = (root_ / "adaptive.yaml").string();
+  const RunResult check = run({"check", scene});
+  if (check.status == 2 && contains(check.err, "adaptive"))
+    GTEST_SKIP() << "the scene parser does not read image.adaptive yet:\n" << check.err;
+  ASSERT_EQ(check.status, 0) << check.err;
+  EXPECT_TRUE(contains(check.out, "32x24, 4 to 8 samples per pixel (adaptive, threshold 0.05)"))
+      << check.out;
+  EXPECT_TRUE(contains(check.out, "lights:    2 + ambient")) << "no area light: " << check.out;
+
+  RunResult r = run({"render", scene, "-o", "out.png", "--stats"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      r.err, m, std::regex(R"(glint: samples: (\d+) \(([0-9.]+) per pixel on average, 4 to 8\))")))
+      << r.err;
+  const double average = std::stod(m[2]);
+  EXPECT_GE(average, 4.0);
+  EXPECT_LE(average, 8.0);
+  EXPECT_NEAR(std::stod(m[1]) / (32 * 24), average, 0.01);
+  // --samples above max_samples raises the maximum: every pixel takes exactly 16.
+  r = run({"render", scene, "-o", "out.png", "--stats", "--samples", "16"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "16 to 16 samples per pixel")) << r.err;
+  EXPECT_TRUE(contains(r.err, "glint: samples: 12288 (16.00 per pixel on average")) << r.err;
 }
 
 }  // namespace

@@ -17,10 +17,11 @@ int percentOf(std::size_t done, std::size_t total) {
   return total == 0 ? 100 : static_cast<int>(done * 100 / total);
 }
 
-// Remaining time, extrapolated linearly from the tiles done so far; negative when unknown.
-double etaSeconds(std::size_t done, std::size_t total, double elapsed) {
-  if (done == 0 || total == 0) return -1;
-  return elapsed * static_cast<double>(total - done) / static_cast<double>(done);
+// Remaining time, extrapolated linearly from the tiles rendered so far (tiles `resumed` from a
+// checkpoint took no time); negative when unknown.
+double etaSeconds(std::size_t done, std::size_t total, std::size_t resumed, double elapsed) {
+  if (done <= resumed || total == 0) return -1;
+  return elapsed * static_cast<double>(total - done) / static_cast<double>(done - resumed);
 }
 
 std::string formatEta(double eta) { return eta < 0 ? std::string("--") : formatDuration(eta); }
@@ -43,7 +44,8 @@ ProgressReporter::Style ProgressReporter::styleFor(std::FILE* stream) {
 ProgressReporter::ProgressReporter(Style style, std::FILE* stream)
     : style_(style), stream_(stream), start_(Clock::now()), lastDraw_(start_) {}
 
-void ProgressReporter::start() {
+void ProgressReporter::start(std::size_t resumed) {
+  resumed_ = resumed;
   start_ = lastDraw_ = Clock::now();
   lastDecile_ = 0;
   if (style_ == Style::Bar) drawBar(0, 1, 0);
@@ -89,14 +91,14 @@ void ProgressReporter::drawBar(std::size_t done, std::size_t total, double elaps
   bar.append(static_cast<std::size_t>(kBarCells - filled), '.');
   // Trailing blanks overwrite the end of a longer previous line (an ETA in minutes, say).
   fmt::print(stream_, "\rglint: [{}] {:3}%  elapsed {}  ETA {}      ", bar, percent,
-             formatDuration(elapsed), formatEta(etaSeconds(done, total, elapsed)));
+             formatDuration(elapsed), formatEta(etaSeconds(done, total, resumed_, elapsed)));
   std::fflush(stream_);
   barDrawn_ = true;
 }
 
 void ProgressReporter::printLine(std::size_t done, std::size_t total, double elapsed) {
   fmt::print(stream_, "glint: {}% (elapsed {}, ETA {})\n", percentOf(done, total),
-             formatDuration(elapsed), formatEta(etaSeconds(done, total, elapsed)));
+             formatDuration(elapsed), formatEta(etaSeconds(done, total, resumed_, elapsed)));
   std::fflush(stream_);
 }
 

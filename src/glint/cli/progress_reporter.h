@@ -25,8 +25,9 @@ class ProgressReporter {
 
   ProgressReporter(Style style, std::FILE* stream);
 
-  // Starts the clock (and draws an empty bar).
-  void start();
+  // Starts the clock (and draws an empty bar). `resumed`: tiles done before the start (copied from
+  // a checkpoint), left out of the ETA.
+  void start(std::size_t resumed = 0);
   // Tiles done out of total. Calls must not overlap (the renderer serialises them).
   void update(std::size_t done, std::size_t total);
   // Ends the bar's line so that later messages start on a fresh line.
@@ -45,6 +46,7 @@ class ProgressReporter {
   int lastDecile_ = 0;     // Lines: the last 10% step printed
   bool barDrawn_ = false;  // Bar: something is on the current line
   bool lastPrinted100_ = false;
+  std::size_t resumed_ = 0;
 };
 
 }  // namespace glint::cli

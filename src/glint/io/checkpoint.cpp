@@ -1,0 +1,432 @@
+#include "glint/io/checkpoint.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <system_error>
+#include <utility>
+
+#include "glint/io/scene_limits.h"
+#include "glint/render/renderer.h"
+
+namespace glint {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Bytes before the tile bitmap: magic, version, reserved, fingerprint, settings, tile count.
+constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 + (4 * 4 + 8 + 8 + 5 * 4) + 8;
+constexpr std::size_t kPixelBytes = 3 * 8;
+// Tiles of at most this many pixels per side; more is not a file glint wrote.
+constexpr std::int64_t kMaxTileSize = 65535;
+
+class Writer {
+ public:
+  void u32(std::uint32_t v) { put(v, 4); }
+  void i32(int v) { put(static_cast<std::uint32_t>(v), 4); }
+  void u64(std::uint64_t v) { put(v, 8); }
+  void f64(double v) { put(std::bit_cast<std::uint64_t>(v), 8); }
+  void bytes(std::string_view b) { out_.append(b); }
+  std::string& text() { return out_; }
+
+ private:
+  void put(std::uint64_t v, int count) {
+    for (int i = 0; i < count; ++i) out_.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+  }
+  std::string out_;
+};
+
+class Reader {
+ public:
+  Reader(std::string_view bytes, const std::string& name) : in_(bytes), name_(name) {}
+  std::uint32_t u32() { return static_cast<std::uint32_t>(get(4)); }
+  int i32() { return static_cast<int>(static_cast<std::int32_t>(get(4))); }
+  std::uint64_t u64() { return get(8); }
+  double f64() { return std::bit_cast<double>(get(8)); }
+  std::string_view bytes(std::size_t count) {
+    need(count);
+    const std::string_view part = in_.substr(pos_, count);
+    pos_ += count;
+    return part;
+  }
+  std::size_t position() const { return pos_; }
+  std::size_t remaining() const { return in_.size() - pos_; }
+
+ private:
+  void need(std::size_t count) const {
+    if (in_.size() - pos_ < count)
+      throw CheckpointError(
+          fmt::format("checkpoint '{}' is truncated ({} bytes)", name_, in_.size()));
+  }
+  std::uint64_t get(int count) {
+    need(static_cast<std::size_t>(count));
+    std::uint64_t v = 0;
+    for (int i = 0; i < count; ++i)
+      v |= std::uint64_t{static_cast<unsigned char>(in_[pos_ + static_cast<std::size_t>(i)])}
+           << (8 * i);
+    pos_ += static_cast<std::size_t>(count);
+    return v;
+  }
+  std::string_view in_;
+  const std::string& name_;
+  std::size_t pos_ = 0;
+};
+
+std::string_view asBytes(const void* data, std::size_t size) {
+  return {static_cast<const char*>(data), size};
+}
+
+template <typename T>
+std::uint64_t hashVector(const std::vector<T>& values, std::uint64_t hash) {
+  const std::uint64_t count = values.size();
+  hash = fnv1a64(asBytes(&count, sizeof count), hash);
+  return fnv1a64(asBytes(values.data(), values.size() * sizeof(T)), hash);
+}
+
+void copyTile(const PixelRegion& tile, const Film& from, Film& to) {
+  const PixelRegion& region = to.region();
+  for (int y = tile.y0; y < tile.y1; ++y)
+    for (int x = tile.x0; x < tile.x1; ++x)
+      to.at(x - region.x0, y - region.y0) = from.at(x - region.x0, y - region.y0);
+}
+
+std::string describeRegion(const PixelRegion& r, int width, int height) {
+  if (r == PixelRegion{0, 0, width, height}) return "the whole image";
+  return fmt::format("--crop {},{},{},{}", r.x0, r.y0, r.x1, r.y1);
+}
+
+}  // namespace
+
+std::uint64_t fnv1a64(std::string_view bytes, std::uint64_t hash) {
+  constexpr std::uint64_t kPrime = 1099511628211ull;
+  for (const char c : bytes) {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= kPrime;
+  }
+  return hash;
+}
+
+CheckpointSettings checkpointSettingsFor(const Scene& scene, const PixelRegion& region,
+                                         int tileSize) {
+  const ImageSettings& image = scene.image();
+  CheckpointSettings s;
+  s.width = image.width;
+  s.height = image.height;
+  s.samples = image.samples;
+  if (image.adaptive) {
+    s.adaptiveMaxSamples = image.adaptive->maxSamples;
+    s.adaptiveThreshold = image.adaptive->threshold;
+  }
+  s.seed = scene.render().seed;
+  s.region = region;
+  s.tileSize = tileSize;
+  return s;
+}
+
+std::uint64_t renderFingerprint(std::string_view sceneFileBytes, const Scene& scene,
+                                const CheckpointSettings& settings) {
+  Writer w;
+  w.u32(kCheckpointVersion);
+  w.bytes(GLINT_VERSION);
+  w.u64(sceneFileBytes.size());
+  std::uint64_t hash = fnv1a64(w.text());
+  hash = fnv1a64(sceneFileBytes, hash);
+  for (const TriangleMesh& mesh : scene.meshes()) {
+    // Point3, Normal3 and uint32 are plain arrays of scalars without padding.
+    static_assert(sizeof(Point3) == 3 * sizeof(double) && sizeof(Normal3) == 3 * sizeof(double));
+    hash = hashVector(mesh.positions, hash);
+    hash = hashVector(mesh.normals, hash);
+    hash = hashVector(mesh.indices, hash);
+    Writer m;
+    m.u32(mesh.materialIndex);
+    m.f64(mesh.emission.r);
+    m.f64(mesh.emission.g);
+    m.f64(mesh.emission.b);
+    hash = fnv1a64(m.text(), hash);
+  }
+  Writer s;
+  s.i32(settings.width);
+  s.i32(settings.height);
+  s.i32(settings.samples);
+  s.i32(settings.adaptiveMaxSamples);
+  s.f64(settings.adaptiveThreshold);
+  s.u64(settings.seed);
+  s.i32(settings.region.x0);
+  s.i32(settings.region.y0);
+  s.i32(settings.region.x1);
+  s.i32(settings.region.y1);
+  s.i32(settings.tileSize);
+  return fnv1a64(s.text(), hash);
+}
+
+std::size_t Checkpoint::finishedTiles() const {
+  std::size_t count = 0;
+  for (const bool done : tiles) count += done ? 1 : 0;
+  return count;
+}
+
+Checkpoint emptyCheckpoint(std::uint64_t fingerprint, const CheckpointSettings& settings) {
+  Checkpoint checkpoint;
+  checkpoint.fingerprint = fingerprint;
+  checkpoint.settings = settings;
+  checkpoint.tiles.assign(tileRegions(settings.region, settings.tileSize).size(), false);
+  checkpoint.film = Film(settings.width, settings.height, settings.region);
+  return checkpoint;
+}
+
+std::string encodeCheckpoint(const Checkpoint& checkpoint) {
+  const CheckpointSettings& s = checkpoint.settings;
+  const std::vector<PixelRegion> tiles = tileRegions(s.region, s.tileSize);
+  if (tiles.size() != checkpoint.tiles.size() || checkpoint.film.region() != s.region)
+    throw std::invalid_argument("checkpoint tiles or film do not match its settings");
+  Writer w;
+  w.bytes(kCheckpointMagic);
+  w.u32(kCheckpointVersion);
+  w.u32(0);
+  w.u64(checkpoint.fingerprint);
+  w.i32(s.width);
+  w.i32(s.height);
+  w.i32(s.samples);
+  w.i32(s.adaptiveMaxSamples);
+  w.f64(s.adaptiveThreshold);
+  w.u64(s.seed);
+  w.i32(s.region.x0);
+  w.i32(s.region.y0);
+  w.i32(s.region.x1);
+  w.i32(s.region.y1);
+  w.i32(s.tileSize);
+  w.u64(tiles.size());
+  std::string bitmap((tiles.size() + 7) / 8, '\0');
+  for (std::size_t i = 0; i < tiles.size(); ++i)
+    if (checkpoint.tiles[i]) bitmap[i / 8] = static_cast<char>(bitmap[i / 8] | (1 << (i % 8)));
+  w.bytes(bitmap);
+  std::size_t pixels = 0;
+  for (std::size_t i = 0; i < tiles.size(); ++i)
+    if (checkpoint.tiles[i])
+      pixels +=
+          static_cast<std::size_t>(tiles[i].width()) * static_cast<std::size_t>(tiles[i].height());
+  w.text().reserve(w.text().size() + pixels * kPixelBytes + 8);
+  for (std::size_t i = 0; i < tiles.size(); ++i) {
+    if (!checkpoint.tiles[i]) continue;
+    const PixelRegion& t = tiles[i];
+    for (int y = t.y0; y < t.y1; ++y) {
+      for (int x = t.x0; x < t.x1; ++x) {
+        const Color& c = checkpoint.film.at(x - s.region.x0, y - s.region.y0);
+        w.f64(c.r);
+        w.f64(c.g);
+        w.f64(c.b);
+      }
+    }
+  }
+  w.u64(fnv1a64(w.text()));
+  return std::move(w.text());
+}
+
+Checkpoint decodeCheckpoint(std::string_view bytes, const std::string& name,
+                            std::uint64_t memoryBudget) {
+  if (bytes.size() < kCheckpointMagic.size() ||
+      bytes.substr(0, kCheckpointMagic.size()) != kCheckpointMagic)
+    throw CheckpointError(fmt::format("'{}' is not a glint checkpoint", name));
+  Reader r(bytes, name);
+  r.bytes(kCheckpointMagic.size());
+  const std::uint32_t version = r.u32();
+  if (version != kCheckpointVersion)
+    throw CheckpointError(
+        fmt::format("checkpoint '{}' has format version {}; this glint reads version {}", name,
+                    version, kCheckpointVersion));
+  const auto corrupt = [&name](const std::string& what) {
+    return CheckpointError(fmt::format("checkpoint '{}' is corrupt: {}", name, what));
+  };
+  // The checksum first, so that damage anywhere is reported as such rather than as an odd value.
+  if (bytes.size() < kHeaderBytes + 8)
+    throw CheckpointError(
+        fmt::format("checkpoint '{}' is truncated ({} bytes)", name, bytes.size()));
+  Reader tail(bytes.substr(bytes.size() - 8), name);
+  if (tail.u64() != fnv1a64(bytes.substr(0, bytes.size() - 8)))
+    throw corrupt("its checksum does not match (damaged or truncated)");
+  r.u32();  // reserved
+  Checkpoint checkpoint;
+  checkpoint.fingerprint = r.u64();
+  CheckpointSettings& s = checkpoint.settings;
+  s.width = r.i32();
+  s.height = r.i32();
+  s.samples = r.i32();
+  s.adaptiveMaxSamples = r.i32();
+  s.adaptiveThreshold = r.f64();
+  s.seed = r.u64();
+  s.region.x0 = r.i32();
+  s.region.y0 = r.i32();
+  s.region.x1 = r.i32();
+  s.region.y1 = r.i32();
+  s.tileSize = r.i32();
+  const PixelRegion& region = s.region;
+  if (s.width < 1 || s.width > 65535 || s.height < 1 || s.height > 65535 || region.x0 < 0 ||
+      region.x0 >= region.x1 || region.x1 > s.width || region.y0 < 0 || region.y0 >= region.y1 ||
+      region.y1 > s.height || s.tileSize < 1 || s.tileSize > kMaxTileSize)
+    throw corrupt("impossible image size, region or tile size");
+  // Sizes are checked before anything is allocated from them.
+  const std::uint64_t tileCount =
+      static_cast<std::uint64_t>((region.width() + s.tileSize - 1) / s.tileSize) *
+      static_cast<std::uint64_t>((region.height() + s.tileSize - 1) / s.tileSize);
+  if (r.u64() != tileCount) throw corrupt("the tile count does not match the tile size");
+  if ((tileCount + 7) / 8 > r.remaining()) throw corrupt("the tile bitmap is cut short");
+  const std::uint64_t film = filmBytes(region.width(), region.height());
+  if (film > memoryBudget)
+    throw CheckpointError(fmt::format(
+        "checkpoint '{}' needs {} for its film, more than the memory budget of {}", name,
+        formatBytes(static_cast<double>(film)), formatBytes(static_cast<double>(memoryBudget))));
+  const std::vector<PixelRegion> tiles = tileRegions(region, s.tileSize);
+  const std::string_view bitmap = r.bytes((tiles.size() + 7) / 8);
+  checkpoint.tiles.assign(tiles.size(), false);
+  std::size_t pixels = 0;
+  for (std::size_t i = 0; i < tiles.size(); ++i) {
+    checkpoint.tiles[i] = (static_cast<unsigned char>(bitmap[i / 8]) >> (i % 8)) & 1;
+    if (checkpoint.tiles[i])
+      pixels +=
+          static_cast<std::size_t>(tiles[i].width()) * static_cast<std::size_t>(tiles[i].height());
+  }
+  if (r.remaining() < 8 || r.remaining() - 8 != pixels * kPixelBytes)
+    throw corrupt(fmt::format("{} bytes of pixels for {} finished tiles, expected {}",
+                              r.remaining() - 8, checkpoint.finishedTiles(), pixels * kPixelBytes));
+  checkpoint.film = Film(s.width, s.height, region);
+  for (std::size_t i = 0; i < tiles.size(); ++i) {
+    if (!checkpoint.tiles[i]) continue;
+    const PixelRegion& t = tiles[i];
+    for (int y = t.y0; y < t.y1; ++y) {
+      for (int x = t.x0; x < t.x1; ++x) {
+        Color& c = checkpoint.film.at(x - region.x0, y - region.y0);
+        c.r = r.f64();
+        c.g = r.f64();
+        c.b = r.f64();
+      }
+    }
+  }
+  return checkpoint;
+}
+
+void writeCheckpoint(const Checkpoint& checkpoint, const fs::path& path) {
+  const std::string bytes = encodeCheckpoint(checkpoint);
+  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  std::string temporary = (folder / (path.filename().string() + ".tmp-XXXXXX")).string();
+  const auto failure = [&path](const std::string& what) {
+    return CheckpointError(fmt::format("cannot save checkpoint '{}': {}", path.string(), what));
+  };
+  const int fd = mkstemp(temporary.data());
+  if (fd < 0) throw failure(std::strerror(errno));
+  std::size_t written = 0;
+  while (written < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const std::string reason = std::strerror(errno);
+      ::close(fd);
+      ::unlink(temporary.c_str());
+      throw failure(reason);
+    }
+    written += static_cast<std::size_t>(n);
+  }
+  // fsync before rename: after a power cut the name points at complete bytes, old or new.
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    const std::string reason = std::strerror(errno);
+    ::unlink(temporary.c_str());
+    throw failure(reason);
+  }
+  if (::rename(temporary.c_str(), path.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    ::unlink(temporary.c_str());
+    throw failure(reason);
+  }
+}
+
+Checkpoint readCheckpoint(const fs::path& path, std::uint64_t memoryBudget) {
+  std::error_code error;
+  if (fs::is_directory(path, error))
+    throw CheckpointError(
+        fmt::format("cannot read checkpoint '{}': it is a folder", path.string()));
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw CheckpointError(
+        fmt::format("cannot read checkpoint '{}': {}", path.string(),
+                    fs::exists(path, error) ? "permission denied" : "no such file"));
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad())
+    throw CheckpointError(fmt::format("cannot read checkpoint '{}': read error", path.string()));
+  return decodeCheckpoint(bytes, path.string(), memoryBudget);
+}
+
+std::optional<std::string> checkpointMismatch(const Checkpoint& checkpoint,
+                                              std::uint64_t fingerprint,
+                                              const CheckpointSettings& settings) {
+  const CheckpointSettings& was = checkpoint.settings;
+  const auto differs = [](const std::string& what, const std::string& then,
+                          const std::string& now) {
+    return fmt::format("it was made with {} {}, this render has {}", what, then, now);
+  };
+  if (was.width != settings.width || was.height != settings.height)
+    return differs("an image of", fmt::format("{}x{}", was.width, was.height),
+                   fmt::format("{}x{}", settings.width, settings.height));
+  if (was.region != settings.region)
+    return differs("region", describeRegion(was.region, was.width, was.height),
+                   describeRegion(settings.region, settings.width, settings.height));
+  if (was.samples != settings.samples)
+    return differs("samples per pixel", std::to_string(was.samples),
+                   std::to_string(settings.samples));
+  if (was.adaptiveMaxSamples != settings.adaptiveMaxSamples ||
+      was.adaptiveThreshold != settings.adaptiveThreshold) {
+    const auto adaptive = [](const CheckpointSettings& s) {
+      return s.adaptiveMaxSamples == 0 ? std::string("off")
+                                       : fmt::format("max_samples {}, threshold {:g}",
+                                                     s.adaptiveMaxSamples, s.adaptiveThreshold);
+    };
+    return differs("adaptive sampling", adaptive(was), adaptive(settings));
+  }
+  if (was.seed != settings.seed)
+    return differs("seed", std::to_string(was.seed), std::to_string(settings.seed));
+  if (was.tileSize != settings.tileSize)
+    return differs("tile size", std::to_string(was.tileSize), std::to_string(settings.tileSize));
+  if (checkpoint.fingerprint != fingerprint)
+    return std::string(
+        "the scene file, a mesh it loads or the glint version differs from the render that made "
+        "it");
+  return std::nullopt;
+}
+
+CheckpointCollector::CheckpointCollector(fs::path path, Checkpoint start,
+                                         std::chrono::duration<double> interval)
+    : path_(std::move(path)),
+      checkpoint_(std::move(start)),
+      tileRegions_(tileRegions(checkpoint_.settings.region, checkpoint_.settings.tileSize)),
+      interval_(interval),
+      lastSave_(Clock::now()) {}
+
+void CheckpointCollector::addTile(std::size_t tile, const Film& film) {
+  if (tile >= tileRegions_.size() || film.region() != checkpoint_.film.region())
+    throw std::invalid_argument("tile or film does not belong to this checkpoint");
+  copyTile(tileRegions_[tile], film, checkpoint_.film);
+  checkpoint_.tiles[tile] = true;
+  unsaved_ = true;
+}
+
+bool CheckpointCollector::saveDue() const {
+  if (!unsaved_) return false;
+  const auto wait = std::max(interval_, 20 * lastSaveTook_);
+  return Clock::now() - lastSave_ >= wait;
+}
+
+void CheckpointCollector::save() {
+  const auto begin = Clock::now();
+  writeCheckpoint(checkpoint_, path_);
+  lastSave_ = Clock::now();
+  lastSaveTook_ = lastSave_ - begin;
+  unsaved_ = false;
+  ++saves_;
+}
+
+}  // namespace glint
