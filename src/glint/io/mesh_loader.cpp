@@ -2,22 +2,31 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <cstring>
 #include <exception>
 #include <new>
+#include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
+#include <assimp/BaseImporter.h>
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/config.h>
+#include <assimp/importerdesc.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -25,6 +34,7 @@
 #include <assimp/Importer.hpp>
 
 #include "glint/io/scene_limits.h"
+#include "glint/io/yaml_tree.h"
 
 namespace glint {
 
@@ -51,8 +61,11 @@ std::string systemReason(int error) {
   return text;
 }
 
+std::string checkedExtension(const std::filesystem::path& path);
+
 // Fails early, with the system's reason, for what assimp would only call "Unable to open file":
-// a missing path, a folder, a device or pipe (which could block or never end), no permission.
+// a missing path, a folder, a device or pipe (which could block or never end), an extension glint
+// does not read (checked before opening), no permission.
 // Returns the file's first bytes (at most kHeaderBytes) and its size.
 constexpr std::size_t kHeaderBytes = 64 * 1024;
 
@@ -64,6 +77,7 @@ std::string readHeader(const std::filesystem::path& path, std::uint64_t& size) {
   }
   if (S_ISDIR(info.st_mode)) throw MeshLoadError("it is a folder, not a mesh file");
   if (!S_ISREG(info.st_mode)) throw MeshLoadError("it is not a regular file");
+  checkedExtension(path);  // before the file is opened
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) throw MeshLoadError(systemReason(errno));
   size = static_cast<std::uint64_t>(info.st_size);
@@ -78,6 +92,72 @@ std::string readHeader(const std::filesystem::path& path, std::uint64_t& size) {
   ::close(fd);
   header.resize(filled);
   return header;
+}
+
+std::string lowerExtension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// The file's extension if glint reads it; otherwise MeshLoadError, before the file is opened.
+std::string checkedExtension(const std::filesystem::path& path) {
+  const std::string ext = lowerExtension(path);
+  for (const char* known : kMeshExtensions) {
+    if (ext == known) return ext;
+  }
+  throw MeshLoadError(fmt::format(
+      "not a mesh format glint reads: {} (glint reads .obj with .mtl, .ply, .stl, .gltf and .glb "
+      "files)",
+      ext.empty() ? std::string("the file name has no extension") : "'" + ext + "'"));
+}
+
+// assimp's file access for one mesh file and the files it names (MTL, glTF buffers): only regular
+// files, read-only. A name such as /dev/zero or a FIFO in a hostile file would otherwise be read
+// without end or block forever.
+class RegularFilesOnly : public Assimp::DefaultIOSystem {
+ public:
+  using DefaultIOSystem::Exists;
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    if (file == nullptr || mode == nullptr ||
+        std::string_view(mode).find_first_of("wa+") != std::string_view::npos) {
+      return nullptr;
+    }
+    return isRegular(file) ? DefaultIOSystem::Open(file, mode) : nullptr;
+  }
+  // DefaultIOSystem::Exists opens the file with fopen, which blocks on a FIFO.
+  bool Exists(const char* file) const override { return isRegular(file); }
+
+ private:
+  static bool isRegular(const char* file) {
+    struct stat info {};
+    return file != nullptr && ::stat(file, &info) == 0 && S_ISREG(info.st_mode);
+  }
+};
+
+// Leaves `importer` with only the importer(s) for `extension`: the glTF 2.0 one for .gltf/.glb
+// (not assimp's glTF 1.0 importer), the one importer of each other extension. assimp falls back to
+// trying every importer's signature test when the chosen one declines; with the others gone there
+// is nothing to fall back to.
+void keepOnlyImporterFor(Assimp::Importer& importer, const std::string& extension) {
+  const std::string bare = extension.substr(1);
+  std::vector<Assimp::BaseImporter*> unwanted;
+  for (std::size_t i = 0; i < importer.GetImporterCount(); ++i) {
+    Assimp::BaseImporter* candidate = importer.GetImporter(i);
+    if (candidate == nullptr) continue;
+    std::set<std::string> extensions;
+    candidate->GetExtensionList(extensions);
+    bool keep = extensions.count(bare) != 0;
+    if (keep && (bare == "gltf" || bare == "glb")) {
+      const aiImporterDesc* info = candidate->GetInfo();
+      keep = info != nullptr && std::string_view(info->mName).find("glTF2") != std::string::npos;
+    }
+    if (!keep) unwanted.push_back(candidate);
+  }
+  for (Assimp::BaseImporter* candidate : unwanted) {
+    // UnregisterLoader hands the importer back without deleting it.
+    if (importer.UnregisterLoader(candidate) == aiReturn_SUCCESS) delete candidate;
+  }
 }
 
 // Bytes of one PLY property value at the least: its size in binary; in ASCII one digit and one
@@ -107,94 +187,186 @@ void refuseFaces(double faces) {
   }
 }
 
-// PLY and OFF headers declare element counts that assimp trusts, reserving memory for them before
-// it reads any element: a 200-byte PLY claiming 300 million faces would cost gigabytes and minutes.
-// Counts that the file's size cannot hold, or more faces than kMaxMeshTriangles, are refused here.
-// Other formats carry no counts (OBJ), or assimp checks them against the size (STL, glTF).
-void checkDeclaredCounts(const std::string& header, std::uint64_t size) {
+// The first `limit` characters of a line from a file, printable, for a message.
+std::string shown(std::string_view text, std::size_t limit = 40) {
+  std::string out;
+  for (const char c : text.substr(0, limit)) {
+    out.push_back(std::isprint(static_cast<unsigned char>(c)) ? c : '?');
+  }
+  return text.size() > limit ? out + "..." : out;
+}
+
+// A PLY header checked line by line before assimp sees it (DESIGN.md §7):
+//  - its structure: a "ply" line, a known format and end_header within the first kHeaderBytes.
+//    assimp 5.2's PLY reader loops without end, growing its memory, on a header that never ends
+//    (found by fuzzing).
+//  - its counts: assimp trusts them, reserving memory before it reads any element: a 200-byte PLY
+//    claiming 300 million faces would cost gigabytes and minutes. Counts the file's size cannot
+//    hold, or more faces than kMaxMeshTriangles, are refused.
+// Returns the declared face and vertex counts (estimateMeshSize's answer).
+MeshSizeEstimate checkPlyHeader(const std::string& header, std::uint64_t size) {
   std::istringstream in(header);
   std::string line;
-  if (header.rfind("ply", 0) == 0) {
-    bool ascii = true;
-    double needed = 0;
-    double elementBytes = 0;
-    double elementCount = 0;
-    std::string declared;
-    while (std::getline(in, line)) {
-      std::istringstream words(line);
-      std::string keyword;
-      words >> keyword;
-      if (keyword == "format") {
-        std::string format;
-        words >> format;
-        ascii = format == "ascii";
-      } else if (keyword == "element" || keyword == "end_header") {
-        needed += elementBytes * elementCount;
-        std::string name;
-        elementCount = 0;
-        elementBytes = 0;
-        if (keyword == "end_header") break;
-        words >> name >> elementCount;
-        if (!words || !(elementCount >= 0)) return;  // not understood: assimp's to judge
-        if (name == "face") refuseFaces(elementCount);
-        declared += fmt::format("{}{} {}", declared.empty() ? "" : " and ",
-                                formatCount(elementCount), name);
-      } else if (keyword == "property") {
-        std::string type;
-        words >> type;
-        if (type == "list") words >> type;  // the count's type; the list may be empty
-        elementBytes += plyScalarBytes(type, ascii);
+  std::getline(in, line);
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (line != "ply") throw MeshLoadError("not a PLY file: it does not start with a 'ply' line");
+  bool ascii = true;
+  bool formatSeen = false;
+  double needed = 0;
+  double elementBytes = 0;
+  double elementCount = 0;
+  double vertexCount = 0;
+  double faceCount = 0;
+  bool ended = false;
+  std::string declared;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (keyword == "format") {
+      std::string format;
+      words >> format;
+      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") {
+        throw MeshLoadError(
+            fmt::format("its PLY header has an unknown format '{}'", shown(format)));
+      }
+      ascii = format == "ascii";
+      formatSeen = true;
+    } else if (keyword == "element" || keyword == "end_header") {
+      needed += elementBytes * elementCount;
+      std::string name;
+      elementCount = 0;
+      elementBytes = 0;
+      if (keyword == "end_header") {
+        ended = true;
+        break;
+      }
+      words >> name >> elementCount;
+      if (!words || !(elementCount >= 0) || !std::isfinite(elementCount)) {
+        throw MeshLoadError(
+            fmt::format("its PLY header has an element without a valid count: '{}'", shown(line)));
+      }
+      if (name == "face") {
+        refuseFaces(elementCount);
+        faceCount += elementCount;
+      }
+      if (name == "vertex") vertexCount += elementCount;
+      declared +=
+          fmt::format("{}{} {}", declared.empty() ? "" : " and ", formatCount(elementCount), name);
+    } else if (keyword == "property") {
+      std::string type;
+      words >> type;
+      if (type == "list") words >> type;  // the count's type; the list may be empty
+      elementBytes += plyScalarBytes(type, ascii);
+    }
+    // Other lines (comments, obj_info, and free text some exporters write) are skipped, as assimp
+    // skips them.
+  }
+  if (!ended || !formatSeen) {
+    throw MeshLoadError(fmt::format(
+        "its PLY header has no {} line in its first {} (a damaged or truncated file)",
+        formatSeen ? "end_header" : "format", formatBytes(static_cast<double>(kHeaderBytes))));
+  }
+  refuseCounts(needed, size, declared + " elements");
+  return MeshSizeEstimate{static_cast<std::uint64_t>(faceCount),
+                          static_cast<std::uint64_t>(vertexCount)};
+}
+
+// The count of accessor `index` of a glTF document, or 0 when there is none.
+std::uint64_t accessorCount(const yaml::Node& accessors, const yaml::Node& index) {
+  if (!index.isScalar()) return 0;
+  std::size_t i = 0;
+  try {
+    i = std::stoul(index.scalar());
+  } catch (const std::exception&) {
+    return 0;
+  }
+  const yaml::Node count = accessors[i].find("count");
+  if (!count.isScalar()) return 0;
+  try {
+    return std::stoull(count.scalar());
+  } catch (const std::exception&) {
+    return 0;
+  }
+}
+
+// glTF primitives checked before assimp sees them. assimp 5.2 makes a strip or fan primitive
+// (mode 3, 5, 6) of n vertices into n − 1 or n − 2 faces without checking n: a primitive with too
+// few vertices (none when POSITION is missing) asks for 2^32 faces, 64 GiB (found by fuzzing).
+// The JSON is read with the YAML reader (JSON is YAML), from the .gltf or the GLB's JSON chunk.
+void checkGltfPrimitives(const std::filesystem::path& path, const std::string& extension,
+                         std::uint64_t size) {
+  std::string text;
+  {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw MeshLoadError(systemReason(errno));
+    std::uint64_t want = size;
+    if (extension == ".glb") {
+      // 12-byte header ("glTF", version, length), then the JSON chunk: length, "JSON", data.
+      unsigned char head[20] = {};
+      if (::read(fd, head, sizeof head) != static_cast<ssize_t>(sizeof head) ||
+          std::memcmp(head + 16, "JSON", 4) != 0) {
+        ::close(fd);
+        return;  // not a GLB assimp would read past its header: its own error
+      }
+      want = std::uint64_t{head[12]} | std::uint64_t{head[13]} << 8 |
+             std::uint64_t{head[14]} << 16 | std::uint64_t{head[15]} << 24;
+      want = std::min(want, size - 20);
+    }
+    text.resize(static_cast<std::size_t>(want));
+    std::size_t filled = 0;
+    while (filled < text.size()) {
+      const ssize_t n = ::read(fd, text.data() + filled, text.size() - filled);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      filled += static_cast<std::size_t>(n);
+    }
+    ::close(fd);
+    text.resize(filled);
+  }
+  yaml::Stream json;
+  try {
+    json = yaml::parse(text);
+  } catch (const yaml::SyntaxError& e) {
+    throw MeshLoadError(fmt::format("invalid file: its JSON cannot be read ({})", e.what()));
+  }
+  const yaml::Node accessors = json.root.find("accessors");
+  const yaml::Node meshes = json.root.find("meshes");
+  for (std::size_t m = 0; m < meshes.size(); ++m) {
+    const yaml::Node primitives = meshes[m].find("primitives");
+    for (std::size_t p = 0; p < primitives.size(); ++p) {
+      const yaml::Node primitive = primitives[p];
+      const std::string mode = primitive.find("mode").scalar();
+      const std::uint64_t minimum = mode == "3" ? 2 : (mode == "5" || mode == "6") ? 3 : 0;
+      if (minimum == 0) continue;
+      const yaml::Node indices = primitive.find("indices");
+      const std::uint64_t count =
+          indices.isDefined()
+              ? accessorCount(accessors, indices)
+              : accessorCount(accessors, primitive.find("attributes").find("POSITION"));
+      if (count < minimum) {
+        throw MeshLoadError(fmt::format(
+            "invalid file: primitive {} of mesh {} is a {} of {} vertices (at least {} needed)", p,
+            m,
+            mode == "3"   ? "line strip"
+            : mode == "5" ? "triangle strip"
+                          : "triangle fan",
+            count, minimum));
       }
     }
-    refuseCounts(needed, size, declared + " elements");
-    return;
   }
-  // OFF: a keyword ending in "OFF" (COFF, NOFF, ...), then vertex, face and edge counts; comments
-  // start with '#'. A vertex takes at least "0 0 0\n", a face "3 0 0 0\n".
-  std::vector<std::string> tokens;
-  while (tokens.size() < 3 && std::getline(in, line)) {
-    std::istringstream words(line.substr(0, line.find('#')));
-    std::string token;
-    while (tokens.size() < 3 && words >> token) tokens.push_back(token);
-    if (tokens.size() == 1 &&
-        (tokens[0].size() < 3 || tokens[0].compare(tokens[0].size() - 3, 3, "OFF") != 0)) {
-      return;
-    }
-  }
-  if (tokens.size() < 3 || tokens[0].size() < 3 ||
-      tokens[0].compare(tokens[0].size() - 3, 3, "OFF") != 0) {
-    return;
-  }
-  double vertices = 0;
-  double faces = 0;
-  try {
-    vertices = std::stod(tokens[1]);
-    faces = std::stod(tokens[2]);
-  } catch (const std::exception&) {
-    return;
-  }
-  refuseFaces(faces);
-  refuseCounts(6 * vertices + 8 * faces, size,
-               fmt::format("{} vertices and {} faces", formatCount(vertices), formatCount(faces)));
 }
 
 // assimp's message in the user's terms.
 std::string assimpReason(std::string_view message) {
   if (message.find("No suitable reader found") != std::string_view::npos) {
-    return "not a mesh format glint reads (OBJ, PLY, STL, glTF 2.0 and the other formats of "
-           "assimp), or a damaged file";
+    return "the file's content does not match its extension, or it is damaged";
   }
   while (!message.empty() && (message.back() == '.' || message.back() == '\n')) {
     message.remove_suffix(1);
   }
   if (message.empty()) return "the mesh library could not read it";
   return "invalid file: " + std::string(message);
-}
-
-bool hasExtension(const std::filesystem::path& path, std::string_view extension) {
-  std::string ext = path.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == extension;
 }
 
 // Triangles a face stands for: a polygon of n ≥ 3 corners fans into n − 2.
@@ -409,12 +581,13 @@ TriangleMesh convertMesh(const aiMesh& in, std::size_t& dropped) {
 
 }  // namespace
 
-MeshFile readMeshFile(const std::filesystem::path& path) {
-  std::uint64_t size = 0;
-  const std::string header = readHeader(path, size);
-  checkDeclaredCounts(header, size);
+namespace {
 
+// assimp's import of a checked file and its conversion to glint's MeshFile, in this process.
+MeshFile importMesh(const std::filesystem::path& path, const std::string& extension) {
   Assimp::Importer importer;
+  importer.SetIOHandler(new RegularFilesOnly);  // the importer owns it
+  keepOnlyImporterFor(importer, extension);
   // Points and lines are not surfaces: SortByPType removes them after triangulation.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
@@ -423,7 +596,7 @@ MeshFile readMeshFile(const std::filesystem::path& path) {
   unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                    aiProcess_PreTransformVertices | aiProcess_GenSmoothNormals |
                    aiProcess_SortByPType;
-  if (hasExtension(path, ".stl")) {
+  if (extension == ".stl") {
     // STL stores one normal per facet, not per vertex: drop them so that GenSmoothNormals (which
     // keeps normals a mesh already has) smooths the surface, and JoinIdenticalVertices can then
     // share the vertices of neighbouring facets.
@@ -509,11 +682,345 @@ MeshFile readMeshFile(const std::filesystem::path& path) {
   return result;
 }
 
-std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path) {
+// ---- The import in a child process. Fuzzing found memory corruption in assimp 5.2's importers
+// (heap overflows in the glTF 2.0 and PLY readers, a crash in OFF's) that no check before the
+// import can rule out: the child process runs assimp and sends the MeshFile back through a pipe;
+// a crash or corruption there is a refused file, never a crashed or corrupted renderer. The parent
+// checks what it receives (sizes, indices, materials) before using it.
+
+static_assert(std::is_trivially_copyable_v<Material> && std::is_trivially_copyable_v<Color> &&
+              std::is_trivially_copyable_v<Point3> && std::is_trivially_copyable_v<Normal3>);
+
+// Writes everything or stops silently (the parent sees a short message).
+bool writeAll(int fd, const void* data, std::size_t size) {
+  const char* p = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, p, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    p += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+template <typename T>
+bool writeValue(int fd, const T& value) {
+  return writeAll(fd, &value, sizeof value);
+}
+
+template <typename T>
+bool writeVector(int fd, const std::vector<T>& values) {
+  return writeValue(fd, std::uint64_t{values.size()}) &&
+         writeAll(fd, values.data(), values.size() * sizeof(T));
+}
+
+bool writeMessage(int fd, char tag, const std::string& text) {
+  return writeValue(fd, tag) && writeValue(fd, std::uint64_t{text.size()}) &&
+         writeAll(fd, text.data(), text.size());
+}
+
+bool writeMeshFile(int fd, const MeshFile& file) {
+  bool ok = writeValue(fd, 'M') && writeValue(fd, std::uint64_t{file.droppedTriangles}) &&
+            writeValue(fd, std::uint64_t{file.materials.size()});
+  for (const MeshMaterial& m : file.materials) {
+    ok = ok && writeMessage(fd, 'N', m.name) && writeValue(fd, m.material) &&
+         writeValue(fd, m.emission) && writeValue(fd, static_cast<char>(m.fromFile));
+  }
+  ok = ok && writeValue(fd, std::uint64_t{file.parts.size()});
+  for (const TriangleMesh& part : file.parts) {
+    ok = ok && writeValue(fd, part.materialIndex) && writeValue(fd, part.emission) &&
+         writeVector(fd, part.positions) && writeVector(fd, part.normals) &&
+         writeVector(fd, part.indices);
+  }
+  return ok;
+}
+
+// Reads what the child sent, refusing anything inconsistent.
+class Reader {
+ public:
+  explicit Reader(int fd) : fd_(fd) {}
+  void bytes(void* data, std::size_t size) {
+    char* p = static_cast<char*>(data);
+    while (size > 0) {
+      const ssize_t n = ::read(fd_, p, size);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) throw MeshLoadError("invalid file: the mesh reader stopped before its answer");
+      p += n;
+      size -= static_cast<std::size_t>(n);
+    }
+  }
+  template <typename T>
+  T value() {
+    T v{};
+    bytes(&v, sizeof v);
+    return v;
+  }
+  std::uint64_t count(std::uint64_t limit) {
+    const auto n = value<std::uint64_t>();
+    if (n > limit) throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+    return n;
+  }
+  template <typename T>
+  void vector(std::vector<T>& out, std::uint64_t limit) {
+    out.resize(static_cast<std::size_t>(count(limit)));
+    bytes(out.data(), out.size() * sizeof(T));
+  }
+  std::string text() {
+    std::string t(static_cast<std::size_t>(count(1 << 20)), '\0');
+    bytes(t.data(), t.size());
+    return t;
+  }
+
+ private:
+  int fd_;
+};
+
+MeshFile receiveMeshFile(Reader& in) {
+  const char tag = in.value<char>();
+  if (tag == 'E') throw MeshLoadError(in.text());
+  if (tag != 'M') throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+  MeshFile file;
+  file.droppedTriangles = static_cast<std::size_t>(in.value<std::uint64_t>());
+  file.materials.resize(static_cast<std::size_t>(in.count(1 << 20)));
+  for (MeshMaterial& m : file.materials) {
+    if (in.value<char>() != 'N') {
+      throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+    }
+    m.name = in.text();
+    m.material = in.value<Material>();
+    m.emission = in.value<Color>();
+    m.fromFile = in.value<char>() != 0;
+  }
+  file.parts.resize(static_cast<std::size_t>(in.count(1 << 20)));
+  std::uint64_t triangles = 0;
+  for (TriangleMesh& part : file.parts) {
+    part.materialIndex = in.value<std::uint32_t>();
+    part.emission = in.value<Color>();
+    in.vector(part.positions, std::uint64_t{1} << 32);
+    in.vector(part.normals, part.positions.size());
+    in.vector(part.indices, 3 * kMaxMeshTriangles);
+    triangles += part.triangleCount();
+    bool ok = part.materialIndex < file.materials.size() && part.indices.size() % 3 == 0 &&
+              (part.normals.empty() || part.normals.size() == part.positions.size()) &&
+              triangles <= kMaxMeshTriangles;
+    for (const std::uint32_t i : part.indices) ok = ok && i < part.positions.size();
+    if (!ok) throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+  }
+  return file;
+}
+
+MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw MeshLoadError(systemReason(errno));
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    const int error = errno;
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw MeshLoadError("cannot start the mesh reader: " + systemReason(error));
+  }
+  if (pid == 0) {
+    // The child: no destructor, atexit handler or stdio flush of the parent's state runs here.
+    ::close(fds[0]);
+    try {
+      writeMeshFile(fds[1], importMesh(path, extension));
+    } catch (const MeshLoadError& e) {
+      writeMessage(fds[1], 'E', e.what());
+    } catch (...) {
+      writeMessage(fds[1], 'E', "invalid file: the mesh library failed reading it");
+    }
+    ::_exit(0);
+  }
+  ::close(fds[1]);
+  std::optional<MeshFile> file;
+  std::string failure;
+  try {
+    Reader in(fds[0]);
+    file = receiveMeshFile(in);
+  } catch (const MeshLoadError& e) {
+    failure = e.what();
+  } catch (const std::bad_alloc&) {
+    failure = "not enough memory to load it";
+  }
+  ::close(fds[0]);  // a child still writing gets EPIPE and ends
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  // SIGPIPE: the child was still writing when the parent stopped reading an inconsistent answer.
+  if (WIFSIGNALED(status) && WTERMSIG(status) != SIGPIPE) {
+    throw MeshLoadError(fmt::format(
+        "invalid file: the mesh library crashed reading it ({}; glint read it in a separate "
+        "process and is unaffected)",
+        strsignal(WTERMSIG(status))));
+  }
+  if (!file) throw MeshLoadError(failure);
+  return std::move(*file);
+}
+
+}  // namespace
+
+MeshFile readMeshFile(const std::filesystem::path& path) {
+  std::uint64_t size = 0;
+  const std::string header = readHeader(path, size);
+  const std::string extension = checkedExtension(path);
+  if (extension == ".ply") checkPlyHeader(header, size);
+  if (extension == ".gltf" || extension == ".glb") checkGltfPrimitives(path, extension, size);
+  return importMeshInChild(path, extension);
+}
+
+namespace {
+
+// Calls `line` with every line of the file (without its '\n'), reading 64 KiB at a time and keeping
+// at most kMaxScannedLine bytes of a line: counting needs no more, and memory stays bounded for any
+// file. Throws MeshLoadError when the file cannot be read.
+constexpr std::size_t kMaxScannedLine = 256;
+
+template <typename LineFn>
+void forEachLine(const std::filesystem::path& path, LineFn&& line) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw MeshLoadError(systemReason(errno));
+  std::string current;
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int error = errno;
+      ::close(fd);
+      throw MeshLoadError(systemReason(error));
+    }
+    if (n == 0) break;
+    for (ssize_t i = 0; i < n; ++i) {
+      const char c = buffer[i];
+      if (c == '\n') {
+        line(std::string_view(current));
+        current.clear();
+      } else if (current.size() < kMaxScannedLine) {
+        current.push_back(c);
+      }
+    }
+  }
+  ::close(fd);
+  if (!current.empty()) line(std::string_view(current));
+}
+
+// Words of a line separated by blanks, counted up to the first comment.
+std::size_t wordCount(std::string_view line) {
+  std::size_t words = 0;
+  bool inWord = false;
+  for (const char c : line) {
+    if (c == '#') break;
+    const bool blank = c == ' ' || c == '\t' || c == '\r';
+    if (!blank && !inWord) ++words;
+    inWord = !blank;
+  }
+  return words;
+}
+
+std::string_view firstWord(std::string_view line) {
+  const std::size_t begin = line.find_first_not_of(" \t\r");
+  if (begin == std::string_view::npos) return {};
+  const std::size_t end = line.find_first_of(" \t\r", begin);
+  return line.substr(begin, end == std::string_view::npos ? line.size() - begin : end - begin);
+}
+
+// Bytes of the glTF file plus the regular files its "uri" strings name (data: URIs are inside the
+// file already). A plain scan for `"uri"`, not a JSON parse: an estimate needs no more.
+std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size) {
+  std::uint64_t total = size;
+  if (size > (std::uint64_t{64} << 20)) return total;  // a .gltf this big holds its own data
+  std::string text;
+  {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw MeshLoadError(systemReason(errno));
+    char buffer[1 << 16];
+    for (;;) {
+      const ssize_t n = ::read(fd, buffer, sizeof buffer);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0 || text.size() > size) break;
+      text.append(buffer, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+  }
+  std::set<std::string> seen;
+  for (std::size_t at = text.find("\"uri\""); at != std::string::npos;
+       at = text.find("\"uri\"", at + 5)) {
+    const std::size_t open = text.find('"', text.find(':', at + 5));
+    if (open == std::string::npos) break;
+    const std::size_t close = text.find('"', open + 1);
+    if (close == std::string::npos) break;
+    const std::string uri = text.substr(open + 1, close - open - 1);
+    if (uri.rfind("data:", 0) == 0 || !seen.insert(uri).second) continue;
+    struct stat info {};
+    const std::filesystem::path file = path.parent_path() / uri;
+    if (::stat(file.c_str(), &info) == 0 && S_ISREG(info.st_mode)) {
+      total += static_cast<std::uint64_t>(info.st_size);
+    }
+  }
+  return total;
+}
+
+}  // namespace
+
+double meshCopyBytes(double triangles, double vertices) {
+  return kMeshBytesPerTriangle * triangles + kMeshBytesPerVertex * vertices;
+}
+
+MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path) {
+  std::uint64_t size = 0;
+  const std::string header = readHeader(path, size);
+  const std::string extension = checkedExtension(path);
+  if (extension == ".ply") return checkPlyHeader(header, size);
+  MeshSizeEstimate estimate;
+  if (extension == ".stl") {
+    // Binary STL: 80 bytes of header, a uint32 count (little-endian), 50 bytes per triangle.
+    if (header.size() >= 84) {
+      std::uint32_t count = 0;
+      for (int i = 3; i >= 0; --i) {
+        count = (count << 8) | static_cast<unsigned char>(header[80 + static_cast<std::size_t>(i)]);
+      }
+      if (size == 84 + 50 * std::uint64_t{count}) {
+        // Vertices are shared after assimp joins them: about half a vertex per triangle.
+        return {count, count / 2};
+      }
+    }
+    forEachLine(path, [&](std::string_view line) {
+      if (firstWord(line) == "facet") ++estimate.triangles;
+    });
+    estimate.vertices = estimate.triangles / 2;
+    return estimate;
+  }
+  if (extension == ".obj") {
+    forEachLine(path, [&](std::string_view line) {
+      const std::string_view word = firstWord(line);
+      if (word == "v") {
+        ++estimate.vertices;
+      } else if (word == "f") {
+        const std::size_t corners = wordCount(line) - 1;
+        if (corners >= 3) estimate.triangles += corners - 2;
+      }
+    });
+    return estimate;
+  }
+  if (extension == ".gltf" || extension == ".glb") {
+    estimate.triangles = gltfBytes(path, size) / 12;
+    estimate.vertices = estimate.triangles / 2;
+    return estimate;
+  }
+  return estimate;  // not reached: every extension of kMeshExtensions is handled above
+}
+
+std::filesystem::path MeshCache::keyOf(const std::filesystem::path& path) {
   std::error_code error;
   std::filesystem::path key = std::filesystem::weakly_canonical(path, error);
   if (error) key = std::filesystem::absolute(path, error).lexically_normal();
   if (error) key = path.lexically_normal();
+  return key;
+}
+
+std::shared_ptr<const MeshFile> MeshCache::read(const std::filesystem::path& key,
+                                                const std::filesystem::path& path) {
   if (const auto it = entries_.find(key); it != entries_.end()) {
     if (it->second.file) return it->second.file;
     throw MeshLoadError(it->second.error);
@@ -527,6 +1034,64 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
     entries_[key] = {nullptr, e.what()};
     throw;
   }
+}
+
+std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path) {
+  return read(keyOf(path), path);
+}
+
+std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path,
+                                                const MeshBudget& budget) {
+  const std::filesystem::path key = keyOf(path);
+  const auto it = entries_.find(key);
+  if (it != entries_.end() && !it->second.file) throw MeshLoadError(it->second.error);
+  const bool cached = it != entries_.end();
+  if (!cached) {
+    MeshSizeEstimate size;
+    try {
+      size = estimateMeshSize(path);
+    } catch (const MeshLoadError& e) {
+      entries_[key] = {nullptr, e.what()};
+      ++filesRead_;
+      throw;
+    }
+    const double triangles = static_cast<double>(size.triangles);
+    const double vertices = static_cast<double>(size.vertices);
+    // The cached file, this object's world copy and its share of the BVH.
+    const double bytes = 2 * meshCopyBytes(triangles, vertices) + kBvhBytesPerTriangle * triangles;
+    const double total = meshBytes_ + bytes + static_cast<double>(budget.otherBytes);
+    if (total > static_cast<double>(budget.limit)) {
+      throw MeshTooLargeError(fmt::format(
+          "its estimated {} triangles need about {} as a mesh and its BVH; with {} already "
+          "committed (the image's film and the meshes before it) that is more than the memory "
+          "limit of {}",
+          formatCount(triangles), formatBytes(bytes),
+          formatBytes(meshBytes_ + static_cast<double>(budget.otherBytes)),
+          formatBytes(static_cast<double>(budget.limit))));
+    }
+  }
+  std::shared_ptr<const MeshFile> file = read(key, path);
+  // The real sizes replace the estimate.
+  double triangles = 0;
+  double vertices = 0;
+  for (const TriangleMesh& part : file->parts) {
+    triangles += static_cast<double>(part.triangleCount());
+    vertices += static_cast<double>(part.positions.size());
+  }
+  const double copy = meshCopyBytes(triangles, vertices);
+  const double bytes = (cached ? copy : 2 * copy) + kBvhBytesPerTriangle * triangles;
+  if (cached && meshBytes_ + bytes + static_cast<double>(budget.otherBytes) >
+                    static_cast<double>(budget.limit)) {
+    throw MeshTooLargeError(fmt::format(
+        "another instance of its {} triangles needs about {} with its BVH; with {} already "
+        "committed (the image's film and the meshes before it) that is more than the memory limit "
+        "of {}",
+        formatCount(triangles), formatBytes(bytes),
+        formatBytes(meshBytes_ + static_cast<double>(budget.otherBytes)),
+        formatBytes(static_cast<double>(budget.limit))));
+  }
+  meshBytes_ += bytes;
+  return file;
 }
 
 std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,

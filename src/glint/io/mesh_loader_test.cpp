@@ -5,8 +5,10 @@
 // and the reasons a file is refused.
 #include "glint/io/mesh_loader.h"
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -683,6 +685,8 @@ TEST(MeshLoader, ReasonsAFileIsRefused) {
   EXPECT_THAT(reasonFor("/dev/null"), HasSubstr("not a regular file"));
   EXPECT_THAT(reasonFor(dir.write("notes.txt", "Hello, this is not a mesh.\n")),
               HasSubstr("not a mesh format"));
+  EXPECT_THAT(reasonFor(dir.write("notes.obj", "Hello, this is not a mesh.\n")),
+              HasSubstr("no triangles"));
   EXPECT_THAT(reasonFor(dir.write("lines.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nl 1 2 3\n")),
               HasSubstr("no triangles"));
   EXPECT_THAT(reasonFor(dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n")),
@@ -722,10 +726,160 @@ TEST(MeshLoader, HeaderCountsTheFileCannotHoldAreRefusedBeforeReading) {
   // The same header with counts the file does hold loads.
   const MeshFile small = readMeshFile(dir.write("d.ply", ply("ascii", "3", "1")));
   EXPECT_EQ(small.triangleCount(), 1u);
+}
 
-  const fs::path off = kModels / "invalid/OutOfMemory.off";  // 309 bytes declaring 353 billion
+// ------------------------------------------------------------------- hostile files (DESIGN §7)
+
+TEST(MeshLoader, OnlyTheDocumentedFormatsReachAnImporter) {
+  TempDir dir;
+  const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  // The same valid OBJ text under other names: only .obj (any case) reads it.
+  EXPECT_EQ(readMeshFile(dir.write("t.OBJ", triangle)).triangleCount(), 1u);
+  for (const char* name :
+       {"t.off", "t.3ds", "t.dae", "t.x", "t.fbx", "t.blend", "t.obj.txt", "t"}) {
+    EXPECT_THAT(reasonFor(dir.write(name, triangle)), HasSubstr("not a mesh format glint reads"))
+        << name;
+  }
+  EXPECT_THAT(reasonFor(dir.write("t", triangle)), HasSubstr("has no extension"));
+  // A missing file says so whatever its name; an existing one is refused by name before it is
+  // opened.
+  EXPECT_EQ(reasonFor(dir.path() / "missing.dae"), "no such file");
+  // Assimp's OFF reader (which crashed under fuzzing) is never reached, even for its test file.
+  const fs::path off = kModels / "OFF/Cube.off";
   ASSERT_TRUE(installed(off));
-  EXPECT_THAT(reasonFor(off), HasSubstr("its header declares"));
+  EXPECT_THAT(reasonFor(off), HasSubstr("not a mesh format glint reads: '.off'"));
+  // A glTF 1.0 file goes to the glTF 2.0 importer only (assimp's 1.0 importer is removed).
+  const fs::path gltf1 = kModels / "glTF/BoxTextured-glTF/BoxTextured.gltf";
+  if (fs::is_regular_file(gltf1)) {
+    EXPECT_THAT(reasonFor(gltf1), HasSubstr("invalid file"));
+  }
+}
+
+TEST(MeshLoader, FilesAMeshNamesAreReadOnlyWhenRegular) {
+  TempDir dir;
+  // An MTL that is a FIFO would block the load forever; /dev/zero would never end. Both are
+  // skipped: the OBJ loads with the default material.
+  const fs::path fifo = dir.path() / "pipe.mtl";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const char* library : {"pipe.mtl", "/dev/zero"}) {
+    const fs::path obj =
+        dir.write("m.obj", std::string("mtllib ") + library +
+                               "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
+    const MeshFile file = readMeshFile(obj);
+    EXPECT_EQ(file.triangleCount(), 1u) << library;
+  }
+  // A glTF buffer on /dev/zero with a huge stated length is refused, not read.
+  const std::string gltf =
+      R"({"asset":{"version":"2.0"},"buffers":[{"uri":"/dev/zero","byteLength":100000000000}],)"
+      R"("bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,)"
+      R"("componentType":5126,"count":3,"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":)"
+      R"({"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0})";
+  EXPECT_THAT(reasonFor(dir.write("zero.gltf", gltf)), HasSubstr("invalid file"));
+}
+
+TEST(MeshLoader, FuzzerFindingsAreRefusedBeforeAssimpSeesThem) {
+  TempDir dir;
+  // assimp 5.2's PLY reader looped without end (and without bound on memory) on a header with no
+  // end_header; glint checks the header's lines first.
+  const std::string start = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n";
+  EXPECT_THAT(reasonFor(dir.write("open.ply", start + "0\n1\n2\n")),
+              HasSubstr("its PLY header has no end_header line in its first 64.0 KiB"));
+  EXPECT_THAT(reasonFor(dir.write("fmt.ply", "ply\nformat utf8 1.0\nend_header\n")),
+              HasSubstr("unknown format 'utf8'"));
+  EXPECT_THAT(reasonFor(dir.write("notply.ply", "v 0 0 0\n")), HasSubstr("not a PLY file"));
+  // A glTF line strip without positions made assimp ask for 2^32 faces (64 GiB).
+  const std::string strip =
+      R"({"asset":{"version":"2.0"},"accessors":[{"componentType":5126,"count":1,"type":"VEC3"}],)"
+      R"("meshes":[{"primitives":[{"attributes":{},"mode":3},{"attributes":{"POSITION":0},)"
+      R"("mode":6}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0})";
+  EXPECT_THAT(reasonFor(dir.write("strip.gltf", strip)),
+              HasSubstr("primitive 0 of mesh 0 is a line strip of 0 vertices (at least 2 needed)"));
+  std::string fan = strip;
+  fan.replace(fan.find("\"mode\":3"), 8, "\"mode\":4");
+  EXPECT_THAT(
+      reasonFor(dir.write("fan.gltf", fan)),
+      HasSubstr("primitive 1 of mesh 0 is a triangle fan of 1 vertices (at least 3 needed)"));
+}
+
+MeshSizeEstimate estimateOf(const fs::path& path) { return estimateMeshSize(path); }
+
+TEST(MeshLoader, SizeEstimatesFromHeadersAndCounts) {
+  TempDir dir;
+  // OBJ: `f` corners fan into n − 2 triangles; `v` lines are vertices; comments do not count.
+  const MeshSizeEstimate obj = estimateOf(
+      dir.write("q.obj",
+                "# f 1 2 3\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf 1 2 3 4\n"
+                "f 1 2 5 # a comment 6 7\n  f 1/1/1 2/2/2 3/3/3 4/4/4 5/5/5\nvn 0 0 1\n"));
+  EXPECT_EQ(obj.triangles, 2u + 1u + 3u);
+  EXPECT_EQ(obj.vertices, 5u);
+  // PLY: the header's counts, one triangle per face.
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
+  const MeshSizeEstimate p = estimateOf(dir.write("s.ply", ply));
+  EXPECT_EQ(p.triangles, 2u);
+  EXPECT_EQ(p.vertices, 4u);
+  // Binary STL: the count in the header when the size matches it; ASCII: `facet` lines.
+  const fs::path binary = kModels / "STL/Spider_binary.stl";
+  ASSERT_TRUE(installed(binary));
+  const std::string bytes = readText(binary);
+  std::uint32_t count = 0;
+  std::memcpy(&count, bytes.data() + 80, 4);
+  EXPECT_EQ(estimateOf(binary).triangles, count);
+  EXPECT_EQ(estimateOf(dir.write("a.stl",
+                                 "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
+                                 "vertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+                                 "  facet normal 0 0 1\nendfacet\nendsolid x\n"))
+                .triangles,
+            2u);
+  // glTF: bytes / 12, the .gltf and the local buffers it names.
+  const std::string gltf = R"({"buffers":[{"uri":"b.bin"},{"uri":"data:,abc"}]})";
+  dir.write("b.bin", std::string(1200, '\0'));
+  EXPECT_EQ(estimateOf(dir.write("g.gltf", gltf)).triangles, (gltf.size() + 1200) / 12);
+  // Unreadable files fail as readMeshFile would.
+  EXPECT_THROW(estimateMeshSize(dir.path() / "none.obj"), MeshLoadError);
+  EXPECT_THROW(estimateMeshSize(dir.write("x.dae", "")), MeshLoadError);
+}
+
+TEST(MeshLoader, TheMemoryEstimateRefusesBeforeReadingAndCountsEveryInstance) {
+  TempDir dir;
+  // A flat strip of 1,000 triangles over 1,002 vertices, all facing +z: assimp neither joins nor
+  // splits a vertex. One copy is 12·1000 + 48·1002 = 60,096 B; a first load costs two copies (the
+  // file's, the instance's) plus 22 B per triangle of BVH: 142,192 B.
+  std::string text;
+  for (int i = 0; i <= 500; ++i) text += fmt::format("v {} 0 0\nv {} 1 0\n", i, i);
+  for (int i = 0; i < 500; ++i) {
+    text += fmt::format("f {} {} {}\nf {} {} {}\n", 2 * i + 1, 2 * i + 3, 2 * i + 2, 2 * i + 2,
+                        2 * i + 3, 2 * i + 4);
+  }
+  const fs::path obj = dir.write("strip.obj", text);
+  const MeshSizeEstimate estimate = estimateMeshSize(obj);
+  ASSERT_EQ(estimate.triangles, 1000u);
+  ASSERT_EQ(estimate.vertices, 1002u);
+  EXPECT_DOUBLE_EQ(meshCopyBytes(1000, 1002), 60096);
+
+  MeshCache refused;
+  try {
+    refused.load(obj, MeshBudget{200000, 57809});  // 142,192 + 57,809 > 200,000
+    ADD_FAILURE() << "loaded";
+  } catch (const MeshTooLargeError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("its estimated 1.0 thousand triangles need about 138.9 KiB"));
+    EXPECT_THAT(e.what(), HasSubstr("more than the memory limit of 195.3 KiB"));
+  }
+  EXPECT_EQ(refused.filesRead(), 0u);  // refused before reading
+
+  MeshCache cache;
+  const auto file = cache.load(obj, MeshBudget{200000, 57808});  // exactly at the limit
+  ASSERT_EQ(file->triangleCount(), 1000u);
+  ASSERT_EQ(file->parts.size(), 1u);
+  ASSERT_EQ(file->parts[0].positions.size(), 1002u);
+  EXPECT_DOUBLE_EQ(cache.meshBytes(), 142192);
+  // A second instance adds one copy and its BVH share (82,096 B), refused past the limit.
+  EXPECT_THROW(cache.load(obj, MeshBudget{142192 + 82095, 0}), MeshTooLargeError);
+  EXPECT_EQ(cache.load(obj, MeshBudget{142192 + 82096, 0}), file);
+  EXPECT_DOUBLE_EQ(cache.meshBytes(), 142192 + 82096);
+  EXPECT_EQ(cache.filesRead(), 1u);
 }
 
 }  // namespace

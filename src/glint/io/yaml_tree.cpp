@@ -5,9 +5,13 @@
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
-#include <sstream>
+#include <algorithm>
+#include <istream>
+#include <streambuf>
 #include <unordered_map>
 #include <utility>
+
+#include <fmt/format.h>
 
 namespace glint::yaml {
 
@@ -31,6 +35,19 @@ constexpr std::size_t kDocumentsRead = 3;
 
 Mark convert(const YAML::Mark& m) { return {m.pos, m.line, m.column}; }
 
+// An istream over text already in memory: the scene file is not copied again for yaml-cpp.
+class TextBuffer : public std::streambuf {
+ public:
+  explicit TextBuffer(const std::string& text) {
+    char* begin = const_cast<char*>(text.data());  // only read: the get area is never written
+    setg(begin, begin, begin + text.size());
+  }
+};
+
+std::uint64_t saturatingAdd(std::uint64_t a, std::uint64_t b) {
+  return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
+
 const std::string& emptyString() {
   static const std::string empty;
   return empty;
@@ -41,7 +58,7 @@ const std::string& emptyString() {
 // Builds the first document's tree from parser events; later documents only record their start.
 class TreeBuilder : public YAML::EventHandler {
  public:
-  explicit TreeBuilder(Tree& tree) : tree_(tree) {}
+  TreeBuilder(Tree& tree, const Limits& limits) : tree_(tree), limits_(limits) {}
 
   std::vector<Mark> starts;
   std::size_t root = kNone;
@@ -53,6 +70,8 @@ class TreeBuilder : public YAML::EventHandler {
     building_ = starts.size() == 1;
     stack_.clear();
   }
+  // Nodes aliases have added so far (each alias counts its anchor's expanded subtree).
+  std::uint64_t aliasNodes = 0;
   void OnDocumentEnd() override { building_ = false; }
   void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override {
     add(Node::Kind::Null, mark, anchor, emptyString());
@@ -62,9 +81,29 @@ class TreeBuilder : public YAML::EventHandler {
     const auto it = anchors_.find(anchor);
     if (it == anchors_.end()) {
       add(Node::Kind::Null, mark, YAML::NullAnchor, emptyString());
-    } else {
-      attach(it->second);
+      return;
     }
+    const std::size_t target = it->second;
+    if (open_[target]) {
+      // `&a [*a]`: the anchor's node would contain itself, and every walk of it never ends.
+      throw SyntaxError(convert(mark),
+                        "an alias (*name) refers to a list or mapping that contains it", false,
+                        true);
+    }
+    aliasNodes = saturatingAdd(aliasNodes, weight_[target]);
+    const std::uint64_t allowed =
+        std::max<std::uint64_t>(limits_.maxAliasNodes, tree_.items.size());
+    if (aliasNodes > allowed) {
+      throw SyntaxError(
+          convert(mark),
+          fmt::format("the aliases (*name) up to here repeat {} nodes, more than the limit of {} "
+                      "(a YAML alias bomb?)",
+                      aliasNodes == UINT64_MAX ? std::string("more than 10^19")
+                                               : std::to_string(aliasNodes),
+                      allowed),
+          false, true);
+    }
+    attach(target);
   }
   void OnScalar(const YAML::Mark& mark, const std::string& /*tag*/, YAML::anchor_t anchor,
                 const std::string& value) override {
@@ -86,7 +125,17 @@ class TreeBuilder : public YAML::EventHandler {
                   const std::string& text) {
     if (!building_) return kNone;
     const std::size_t index = tree_.items.size();
+    if (index >= limits_.maxNodes) {
+      throw SyntaxError(convert(mark),
+                        fmt::format("the document holds more than {} values (scalars, lists and "
+                                    "mappings); a scene file describes a scene, and large "
+                                    "geometry belongs in mesh files",
+                                    limits_.maxNodes),
+                        false, true);
+    }
     tree_.items.push_back({kind, convert(mark), text, {}});
+    weight_.push_back(1);
+    open_.push_back(false);
     if (anchor != YAML::NullAnchor) anchors_[anchor] = index;
     attach(index);
     return index;
@@ -99,16 +148,31 @@ class TreeBuilder : public YAML::EventHandler {
     }
   }
   void open(std::size_t index) {
-    if (index != kNone) stack_.push_back(index);
+    if (index == kNone) return;
+    stack_.push_back(index);
+    open_[index] = true;
   }
+  // A closed collection's weight: itself plus its children's (aliased subtrees included).
   void close() {
-    if (building_ && !stack_.empty()) stack_.pop_back();
+    if (!building_ || stack_.empty()) return;
+    const std::size_t index = stack_.back();
+    stack_.pop_back();
+    open_[index] = false;
+    std::uint64_t weight = 1;
+    for (const std::size_t child : tree_.items[index].children) {
+      weight = saturatingAdd(weight, weight_[child]);
+    }
+    weight_[index] = weight;
   }
 
   Tree& tree_;
+  const Limits limits_;
   bool building_ = false;
   std::vector<std::size_t> stack_;  // open collections
   std::unordered_map<YAML::anchor_t, std::size_t> anchors_;
+  // Per item: nodes of its subtree with aliases expanded (saturating), and whether it is open.
+  std::vector<std::uint64_t> weight_;
+  std::vector<bool> open_;
 };
 
 Node::Kind Node::kind() const { return tree_ ? tree_->items[index_].kind : Kind::Undefined; }
@@ -148,11 +212,12 @@ Node Node::find(std::string_view name) const {
   return {};
 }
 
-Stream parse(const std::string& text) {
+Stream parse(const std::string& text, const Limits& limits) {
   auto tree = std::make_shared<Tree>();
-  TreeBuilder builder(*tree);
+  TreeBuilder builder(*tree, limits);
   try {
-    std::istringstream in(text);
+    TextBuffer buffer(text);
+    std::istream in(&buffer);
     YAML::Parser parser(in);
     while (builder.starts.size() < kDocumentsRead && parser.HandleNextDocument(builder)) {
     }

@@ -1,9 +1,11 @@
 // YAML text as a plain tree with the place of every node, read in one pass of yaml-cpp's event
 // parser (no YAML::Node): faster than YAML::Load, keeps duplicate keys for the caller to report,
-// and bounds the document loop that yaml-cpp 0.7's LoadAll runs forever on a stray ','.
+// bounds the document loop that yaml-cpp 0.7's LoadAll runs forever on a stray ',', and refuses
+// hostile documents (alias bombs, self-containing aliases, too many nodes) while reading them.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -19,13 +21,30 @@ struct Mark {
   int column = -1;
 };
 
-// A syntax error of the text, with yaml-cpp's own message (callers put it in plain words).
+// Nodes (scalars, nulls, lists, mappings) one document may hold: about 90 bytes each in the tree,
+// so at most ~380 MB. A scene description is far smaller (meshes belong in mesh files).
+inline constexpr std::size_t kMaxNodes = std::size_t{1} << 22;
+
+// Nodes that aliases (*name) may add when expanded — every alias stands for its anchor's whole
+// subtree, which the caller walks once per alias — on top of the document's own nodes: at most
+// max(kMaxAliasNodes, the document's node count). Without a bound, nested aliases ("billion
+// laughs") grow exponentially and even one level (a 50,000-point list aliased 20,000 times, 630 KB
+// of text) asks for 10^9 points.
+inline constexpr std::uint64_t kMaxAliasNodes = std::uint64_t{1} << 22;
+
+// A syntax error of the text, with yaml-cpp's own message (callers put it in plain words), or a
+// document refused for its size (`refused`: the message is already plain words).
 class SyntaxError : public std::runtime_error {
  public:
-  SyntaxError(const Mark& where, const std::string& message, bool nestedTooDeeply)
-      : std::runtime_error(message), mark(where), tooDeep(nestedTooDeeply) {}
+  SyntaxError(const Mark& where, const std::string& message, bool nestedTooDeeply,
+              bool refusedForSize = false)
+      : std::runtime_error(message),
+        mark(where),
+        tooDeep(nestedTooDeeply),
+        refused(refusedForSize) {}
   Mark mark;
   bool tooDeep;  // lists or mappings nested beyond yaml-cpp's depth guard
+  bool refused;  // kMaxNodes, kMaxAliasNodes or an alias inside its own anchor
 };
 
 struct Tree;
@@ -68,7 +87,15 @@ struct Stream {
   bool stuck = false;  // the parser repeated an empty document at one place: a stray token there
 };
 
-// Parses `text`. Throws SyntaxError.
-Stream parse(const std::string& text);
+// The bounds parse() enforces; tests lower them.
+struct Limits {
+  std::size_t maxNodes = kMaxNodes;
+  std::uint64_t maxAliasNodes = kMaxAliasNodes;
+};
+
+// Parses `text` (read in place, not copied). Throws SyntaxError: yaml-cpp's syntax errors, nesting
+// deeper than yaml-cpp's guard, more than maxNodes nodes, aliases expanding beyond
+// max(maxAliasNodes, nodes so far), an alias to a list or mapping from inside it (a cycle).
+Stream parse(const std::string& text, const Limits& limits = {});
 
 }  // namespace glint::yaml
