@@ -8,12 +8,14 @@
 #   --build-dir DIR  build tree to use (default build/, the release preset's)
 #   --no-build       run what DIR already holds
 #   --only NAMES     comma-separated subset of: ray_throughput, build_memory, bvh_scaling,
-#                    renderer_comparison
+#                    renderer_comparison, adaptive_sampling
 #
 # Needs Embree 3, Tachyon and POV-Ray (scripts/setup.sh bench installs them). Everything printed is
 # also saved to DIR/bench-results/bench-DATE.txt; the renderer comparison leaves its scenes, logs and
 # one PNG per renderer in DIR/bench-results/renderer_comparison/. The machine should be otherwise idle:
-# the load average is printed at the start and end of every program.
+# the load average is printed at the start and end of every program. adaptive_sampling (the
+# showcase at 320x180, adaptive against fixed sampling at equal error) caches its reference render
+# in DIR/bench/adaptive_sampling_cache/.
 # Environment: GLINT_JOBS (build jobs, default 2).
 set -euo pipefail
 
@@ -24,7 +26,7 @@ quick=()
 runs=()
 build_dir=build
 build=1
-only=ray_throughput,build_memory,bvh_scaling,renderer_comparison
+only=ray_throughput,build_memory,bvh_scaling,renderer_comparison,adaptive_sampling
 while (($#)); do
   case "$1" in
     --quick) quick=(--quick) ;;
@@ -42,7 +44,7 @@ while (($#)); do
       shift
       ;;
     -h | --help)
-      sed -n '2,17s/^# \{0,1\}//p' "${BASH_SOURCE[0]}"
+      sed -n '2,19s/^# \{0,1\}//p' "${BASH_SOURCE[0]}"
       exit 0
       ;;
     *)
@@ -69,7 +71,7 @@ if ((build)); then
 fi
 
 bench_bin="$build_dir/bench"
-[[ -x "$bench_bin/ray_throughput" ]] ||
+[[ -x "$bench_bin/${only%%,*}" ]] ||
   { printf 'bench: error: no benchmarks in %s (build with -DGLINT_BUILD_BENCH=ON)\n' "$bench_bin" >&2; exit 1; }
 grep -q 'CMAKE_BUILD_TYPE:STRING=Release' "$build_dir/CMakeCache.txt" ||
   printf 'bench: warning: %s is not a Release build; the figures mean little\n' "$build_dir" >&2
@@ -96,6 +98,7 @@ run() {
   run bvh_scaling "$bench_bin/bvh_scaling" "${quick[@]}" "${runs[@]}"
   run renderer_comparison "$bench_bin/renderer_comparison" "${quick[@]}" "${runs[@]}" \
     --out "$results/renderer_comparison"
+  run adaptive_sampling "$bench_bin/adaptive_sampling" "${quick[@]}" "${runs[@]}"
   printf '\nuptime: %s\n' "$(uptime)"
 } 2>&1 | tee "$log"
 printf 'bench: results saved to %s\n' "$log" >&2
