@@ -31,38 +31,8 @@ namespace {
 using testing::errorsOf;
 using testing::expectOneError;
 using ::testing::HasSubstr;
+using testing::kDesignExample;
 using testing::kMinimal;
-
-constexpr const char* kDesignExample = R"(name: basic render
-background: "#4b7f5a"
-ambient: { color: [1, 0.75, 0.75], intensity: 1 }
-camera:
-  position: [0, 0, 0]
-  direction: [0, 0, -1]
-  up: [0, 1, 0]
-  view_plane: { width: 500, height: 500, distance: 100 }
-  aperture: 0
-image:
-  width: 1000
-  height: 1000
-  samples: 1
-  encoding: srgb
-  grid: { interval: 100, color: "#ffff00" }
-render:
-  max_depth: 10
-  min_weight: 0.001
-  blur_samples: 16
-  seed: 0
-materials:
-  glass: { kd: 0.1, ks: 0.8, shininess: 200, kt: 0.9, ior: 1.5 }
-objects:
-  - { type: sphere, center: [0, 0, -100], radius: 50, material: glass }
-  - { type: triangle, vertices: [[-100, 0, -100], [0, 100, -100], [-100, 100, -100]],
-      emission: "#ff0000", material: { kd: 0.5, ks: 0.5, shininess: 60 } }
-lights:
-  - { type: spot, position: [-50, -50, 50], direction: [1, 1, -2], color: [1, 0.6, 0],
-      intensity: 1, attenuation: [1, 0.00001, 0.00000001], exponent: 1 }
-)";
 
 // Loads a scene that must be valid.
 SceneParts partsOf(const std::string& text) {

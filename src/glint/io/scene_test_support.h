@@ -18,6 +18,40 @@ inline constexpr const char* kMinimal =
     "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n"
     "image: {width: 4, height: 3}\n";
 
+// The example scene of DESIGN.md §5, verbatim (comments included, so its line numbers are the
+// document's).
+inline constexpr const char* kDesignExample = R"(name: basic render                 # optional
+background: "#4b7f5a"              # default black
+ambient: { color: [1, 0.75, 0.75], intensity: 1 }     # default none
+camera:
+  position: [0, 0, 0]
+  direction: [0, 0, -1]            # or look_at: [x, y, z]
+  up: [0, 1, 0]                    # default [0, 1, 0]
+  view_plane: { width: 500, height: 500, distance: 100 }   # or fov: 40
+  aperture: 0                      # optional, with focus_distance
+image:
+  width: 1000                      # pixels
+  height: 1000
+  samples: 1                       # per pixel
+  encoding: srgb                   # srgb (default) | linear (value × 255, rounded to nearest)
+  grid: { interval: 100, color: "#ffff00" }   # optional: after rendering, paints every pixel
+                                              # whose column or row is a multiple of interval (0 too)
+render:
+  max_depth: 10
+  min_weight: 0.001
+  blur_samples: 16
+  seed: 0
+materials:
+  glass: { kd: 0.1, ks: 0.8, shininess: 200, kt: 0.9, ior: 1.5 }
+objects:
+  - { type: sphere, center: [0, 0, -100], radius: 50, material: glass }
+  - { type: triangle, vertices: [[-100, 0, -100], [0, 100, -100], [-100, 100, -100]],
+      emission: "#ff0000", material: { kd: 0.5, ks: 0.5, shininess: 60 } }
+lights:
+  - { type: spot, position: [-50, -50, 50], direction: [1, 1, -2], color: [1, 0.6, 0],
+      intensity: 1, attenuation: [1, 0.00001, 0.00000001], exponent: 1 }
+)";
+
 // Every error loading `text` (as "test.yaml") reports; empty when it loads.
 inline std::vector<Diagnostic> errorsOf(const std::string& text) {
   try {
