@@ -130,10 +130,6 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
   return split ? std::max<std::uint32_t>(1, (samples + blurSamples - 1) / blurSamples) : samples;
 }
 
-// Direct lighting (DESIGN.md §3) with the shading normal ns (= n except on smooth meshes) in the
-// diffuse term and in r. The side tests and the shadow ray's origin use the geometric n; a light on
-// the other side of ns than of n gives no diffuse term. An area light is the average of its
-// sample points, each a point light of I0 with its own distance falloff and shadow ray.
 // An area light's term: the average over its sample points, each a point light of I0 with its own
 // distance falloff and shadow ray. Kept out of line so that the loop over the other lights stays
 // small.
@@ -152,6 +148,9 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
   return sum / static_cast<double>(count);
 }
 
+// Direct lighting (DESIGN.md §3) with the shading normal ns (= n except on smooth meshes) in the
+// diffuse term and in r. The side tests and the shadow ray's origin use the geometric n; a light on
+// the other side of ns than of n gives no diffuse term.
 Color directLight(const TraceContext& ctx, const ShadingPoint& sp, const SampleStream& stream,
                   bool split) {
   Color sum;
