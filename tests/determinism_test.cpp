@@ -17,58 +17,16 @@
 #include "glint/io/image_writer.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/scene.h"
+#include "test_scenes.h"
 
 namespace glint {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::glossyTestScene;
 
-constexpr int kWidth = 24;
-constexpr int kHeight = 20;
-
-// Glossy reflection and blurred refraction through glass, supersampled: every random decision of
-// the renderer is exercised (pixel jitter, cone samples for both lobes, the split rule below them).
-SceneParts glossyParts(std::uint64_t seed) {
-  SceneParts parts;
-  parts.camera.position = {0, 1, 4};
-  parts.camera.direction = {0, -0.2, -1};
-  parts.camera.fovDegrees = 50;
-  parts.image.width = kWidth;
-  parts.image.height = kHeight;
-  parts.image.samples = 4;
-  parts.image.encoding = Encoding::Srgb;
-  parts.render.blurSamples = 4;
-  parts.render.maxDepth = 5;
-  parts.render.seed = seed;
-  parts.background = Color(0.2, 0.3, 0.5);
-  parts.ambient = Color(0.05);
-
-  Material floor;
-  floor.kd = Color(0.5, 0.5, 0.45);
-  floor.kr = Color(0.4);
-  floor.reflectionBlur = 12;
-  Material glass;
-  glass.kd = Color(0.05);
-  glass.ks = Color(0.8);
-  glass.shininess = 100;
-  glass.kt = Color(0.85);
-  glass.ior = 1.5;
-  glass.refractionBlur = 6;
-  Material red;
-  red.kd = Color(0.8, 0.1, 0.1);
-  red.ks = Color(0.3);
-  red.shininess = 30;
-  parts.materials.push_back(floor);
-  parts.materials.push_back(glass);
-  parts.materials.push_back(red);
-  parts.primitives.emplace_back(Plane::make({0, -1, 0}, {0, 1, 0}), 1u, Color{});
-  parts.primitives.emplace_back(Sphere::make({0, 0, -1}, 1), 2u, Color{});
-  parts.primitives.emplace_back(Sphere::make({1.5, -0.3, -3}, 0.7), 3u, Color{});
-  parts.primitives.emplace_back(Sphere::make({-1.6, -0.4, -2.5}, 0.6), 3u, Color{});
-  parts.lights.push_back(PointLight{{3, 5, 3}, Color(40, 38, 35), {1, 0, 1}});
-  parts.lights.push_back(DirectionalLight{normalize(Vec3{-0.5, -1, -0.3}), Color(0.4)});
-  return parts;
-}
+constexpr int kWidth = testing::kGlossySceneWidth;
+constexpr int kHeight = testing::kGlossySceneHeight;
 
 bool bitwiseEqual(const Film& a, const Film& b) {
   return a.region() == b.region() && a.pixels().size() == b.pixels().size() &&
@@ -81,7 +39,7 @@ std::vector<char> fileBytes(const fs::path& path) {
 }
 
 TEST(Determinism, ThreadCountDoesNotChangeFilmOrBytes) {
-  const Scene scene(glossyParts(0));
+  const Scene scene(glossyTestScene(0));
   RenderOptions one;
   one.threads = 1;
   RenderOptions two;
@@ -109,7 +67,7 @@ TEST(Determinism, ThreadCountDoesNotChangeFilmOrBytes) {
 }
 
 TEST(Determinism, StitchedCropsEqualTheFullRender) {
-  const Scene scene(glossyParts(0));
+  const Scene scene(glossyTestScene(0));
   const Film full = render(scene);
   // Crop edges deliberately off the tile grid.
   const int xs[] = {0, 9, 17, kWidth};
@@ -131,9 +89,9 @@ TEST(Determinism, StitchedCropsEqualTheFullRender) {
 }
 
 TEST(Determinism, DifferentSeedChangesTheGlossyPixels) {
-  const Film a = render(Scene(glossyParts(0)));
-  const Film b = render(Scene(glossyParts(1)));
-  const Film again = render(Scene(glossyParts(0)));
+  const Film a = render(Scene(glossyTestScene(0)));
+  const Film b = render(Scene(glossyTestScene(1)));
+  const Film again = render(Scene(glossyTestScene(0)));
   EXPECT_TRUE(bitwiseEqual(a, again));
   int differing = 0;
   for (std::size_t i = 0; i < a.pixels().size(); ++i)
@@ -144,7 +102,7 @@ TEST(Determinism, DifferentSeedChangesTheGlossyPixels) {
 
 TEST(Determinism, SeedLeavesADeterministicSceneUnchanged) {
   // Without glossy materials and with one sample per pixel nothing is random.
-  SceneParts parts = glossyParts(0);
+  SceneParts parts = glossyTestScene(0);
   parts.image.samples = 1;
   for (Material& m : parts.materials) m.reflectionBlur = m.refractionBlur = 0;
   SceneParts other = parts;

@@ -13,6 +13,7 @@
 #include "glint/geometry/shape.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/scene.h"
+#include "test_scenes.h"
 
 namespace glint {
 namespace {
@@ -234,42 +235,14 @@ TEST(DistributedConvergence, SoftShadowErrorFallsAtLeastLikeOneOverSqrtN) {
 // blurred refraction, and all three area-light shapes (one behind glass, so the kt product
 // applies per light sample).
 SceneParts everythingParts(std::uint64_t seed) {
-  SceneParts parts;
-  parts.camera.position = {0, 1, 4};
-  parts.camera.direction = {0, -0.2, -1};
-  parts.camera.fovDegrees = 50;
+  SceneParts parts = testing::glossyTestScene(seed);
   parts.camera.aperture = 0.08;
   parts.camera.focusDistance = 5;
-  parts.image.width = 24;
-  parts.image.height = 20;
   parts.image.samples = 2;
   parts.image.adaptive = AdaptiveSampling{12, 0.01};
   parts.render.blurSamples = 3;
   parts.render.maxDepth = 4;
-  parts.render.seed = seed;
-  parts.background = Color(0.2, 0.3, 0.5);
-  parts.ambient = Color(0.05);
-  Material floor;
-  floor.kd = Color(0.5, 0.5, 0.45);
-  floor.kr = Color(0.4);
-  floor.reflectionBlur = 12;
-  Material glass;
-  glass.kd = Color(0.05);
-  glass.ks = Color(0.8);
-  glass.shininess = 100;
-  glass.kt = Color(0.85);
-  glass.ior = 1.5;
-  glass.refractionBlur = 6;
-  Material red;
-  red.kd = Color(0.8, 0.1, 0.1);
-  red.ks = Color(0.3);
-  red.shininess = 30;
-  parts.primitives.emplace_back(Plane::make({0, -1, 0}, {0, 1, 0}), addMaterial(parts, floor),
-                                Color{});
-  parts.primitives.emplace_back(Sphere::make({0, 0, -1}, 1), addMaterial(parts, glass), Color{});
-  const std::uint32_t r = addMaterial(parts, red);
-  parts.primitives.emplace_back(Sphere::make({1.5, -0.3, -3}, 0.7), r, Color{});
-  parts.primitives.emplace_back(Sphere::make({-1.6, -0.4, -2.5}, 0.6), r, Color{});
+  parts.lights.clear();  // the glossy scene's point and directional lights give way to area lights
   AreaLight rectangle;
   rectangle.corner = {1, 4, 0};
   rectangle.edge1 = {1.5, 0, 0};
