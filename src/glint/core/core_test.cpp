@@ -3,7 +3,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numbers>
 #include <set>
 #include <stdexcept>
@@ -479,6 +482,22 @@ TEST(CoreSpawn, OffsetMovesToTheSideOfTheNewDirectionByABoundedAmount) {
   const Ray r = spawnRay(p, n, {0, 1, 1});
   EXPECT_EQ(r.direction, (Vec3{0, 1, 1}));
   EXPECT_EQ(r.origin, offsetRayOrigin(p, n, {0, 1, 1}));
+}
+
+TEST(CoreSpawn, NextDoubleStepsExactlyAsNextafter) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr double kMax = std::numeric_limits<double>::max();
+  constexpr double kTiny = std::numeric_limits<double>::denorm_min();
+  constexpr double kMinNormal = std::numeric_limits<double>::min();
+  for (const double x : {0.0, -0.0, kTiny, -kTiny, kMinNormal, -kMinNormal, 1.0, -1.0, 0.1, -3e-300,
+                         2e6, -2e6, 1e300, kMax, -kMax}) {
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(nextDoubleUp(x)),
+              std::bit_cast<std::uint64_t>(std::nextafter(x, kInf)))
+        << x;
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(nextDoubleDown(x)),
+              std::bit_cast<std::uint64_t>(std::nextafter(x, -kInf)))
+        << x;
+  }
 }
 
 }  // namespace

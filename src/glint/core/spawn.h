@@ -2,7 +2,9 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "glint/core/ray.h"
@@ -36,6 +38,15 @@ constexpr double gammaBound(int n) {
   return n * u / (1 - n * u);
 }
 
+// The next double above x toward +inf (std::nextafter(x, +inf) for finite x, without the library
+// call: it runs three times per spawned ray). −0 and +0 both step to the smallest subnormal.
+inline double nextDoubleUp(double x) {
+  if (x == 0) return std::numeric_limits<double>::denorm_min();
+  const auto bits = std::bit_cast<std::uint64_t>(x);
+  return std::bit_cast<double>(x > 0 ? bits + 1 : bits - 1);
+}
+inline double nextDoubleDown(double x) { return -nextDoubleUp(-x); }
+
 // Moves the hit point p (per-coordinate error bound pError) off its surface along the geometric
 // unit normal n, to the side the direction w leaves toward (the +n side when w is tangent).
 inline Point3 offsetRayOrigin(const Point3& p, const Vec3& pError, const Normal3& n,
@@ -44,13 +55,12 @@ inline Point3 offsetRayOrigin(const Point3& p, const Vec3& pError, const Normal3
       2 * (std::abs(n.x) * pError.x + std::abs(n.y) * pError.y + std::abs(n.z) * pError.z);
   const double side = dot(n, w) >= 0 ? 1.0 : -1.0;
   const Vec3 along = toVec(n) * side;
-  constexpr double kUp = std::numeric_limits<double>::infinity();
   Point3 o = p + along * d;
   // One ulp further away from the surface on every axis the normal has a component along: covers
   // the rounding of the addition above, and moves the origin even when pError is 0 (box faces).
   for (int axis = 0; axis < 3; ++axis) {
-    if (along[axis] > 0) o[axis] = std::nextafter(o[axis], kUp);
-    if (along[axis] < 0) o[axis] = std::nextafter(o[axis], -kUp);
+    if (along[axis] > 0) o[axis] = nextDoubleUp(o[axis]);
+    if (along[axis] < 0) o[axis] = nextDoubleDown(o[axis]);
   }
   return o;
 }
