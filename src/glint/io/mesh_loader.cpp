@@ -1140,7 +1140,21 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
   const auto it = entries_.find(key);
   if (it != entries_.end() && !it->second.file) throw MeshLoadError(it->second.error);
   const bool cached = it != entries_.end();
+  // An OBJ or STL whose size alone shows that no estimate could exceed the budget is not scanned
+  // (a 100k-triangle OBJ: ~10 ms saved). A file that cannot be read fails in read() instead.
+  bool bounded = false;
   if (!cached) {
+    const std::string ext = lowerExtension(path);
+    struct stat info {};
+    if ((ext == ".obj" || ext == ".stl") && ::stat(path.c_str(), &info) == 0 &&
+        S_ISREG(info.st_mode)) {
+      const double bound =
+          kMeshBudgetBytesPerFileByte * static_cast<double>(info.st_size) + kMeshBudgetSlackBytes;
+      bounded = meshBytes_ + bound + static_cast<double>(budget.otherBytes) <=
+                static_cast<double>(budget.limit);
+    }
+  }
+  if (!cached && !bounded) {
     MeshSizeEstimate size;
     try {
       size = estimateMeshSize(path);

@@ -942,6 +942,50 @@ TEST(MeshLoader, SizeEstimatesFromHeadersAndCounts) {
   EXPECT_THROW(estimateMeshSize(dir.write("x.dae", "")), MeshLoadError);
 }
 
+TEST(MeshLoader, TheFileSizeBoundsEveryEstimate) {
+  // MeshCache skips the scan when kMeshBudgetBytesPerFileByte × size + kMeshBudgetSlackBytes fits
+  // the budget: that must bound what the estimate would count for the densest files possible.
+  TempDir dir;
+  const auto budgetBytes = [](const MeshSizeEstimate& e) {
+    const double t = static_cast<double>(e.triangles);
+    return 2 * meshCopyBytes(t, static_cast<double>(e.vertices)) + kBvhBytesPerTriangle * t;
+  };
+  const auto bound = [](const fs::path& file) {
+    return kMeshBudgetBytesPerFileByte * static_cast<double>(fs::file_size(file)) +
+           kMeshBudgetSlackBytes;
+  };
+  std::string vertices;
+  for (int i = 0; i < 1000; ++i) vertices += "v\n";
+  std::string fans;
+  for (int corners = 3; corners < 200; ++corners) {
+    fans += "f";
+    for (int k = 0; k < corners; ++k) fans += " 1";
+    fans += "\n";
+  }
+  std::string facets;
+  for (int i = 0; i < 1000; ++i) facets += "facet\n";
+  const fs::path spider = kModels / "STL/Spider_binary.stl";
+  ASSERT_TRUE(installed(spider));
+  for (const fs::path& file :
+       {dir.write("v.obj", vertices + "v"), dir.write("f.obj", fans + "f 1 1 1"),
+        dir.write("mixed.obj", vertices + fans), dir.write("a.stl", facets + "facet"), spider}) {
+    const MeshSizeEstimate estimate = estimateMeshSize(file);
+    EXPECT_GT(estimate.triangles + estimate.vertices, 0u) << file;
+    EXPECT_LE(budgetBytes(estimate), bound(file)) << file;
+  }
+  // Vertex lines alone reach it: the factor is not loose.
+  const fs::path dense = dir.write("dense.obj", vertices);
+  EXPECT_DOUBLE_EQ(budgetBytes(estimateMeshSize(dense)) + kMeshBudgetSlackBytes, bound(dense));
+
+  // With a budget the bound fits, the cache still counts the real sizes of what it read.
+  const fs::path obj = dir.write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  MeshCache cache;
+  ASSERT_EQ(cache.load(obj, MeshBudget{std::uint64_t{1} << 30, 0})->triangleCount(), 1u);
+  EXPECT_DOUBLE_EQ(cache.meshBytes(), 2 * meshCopyBytes(1, 3) + kBvhBytesPerTriangle);
+  EXPECT_THROW(cache.load(dir.path() / "none.obj", MeshBudget{std::uint64_t{1} << 30, 0}),
+               MeshLoadError);
+}
+
 TEST(MeshLoader, TheMemoryEstimateRefusesBeforeReadingAndCountsEveryInstance) {
   TempDir dir;
   // A flat strip of 1,000 triangles over 1,002 vertices, all facing +z: assimp neither joins nor
