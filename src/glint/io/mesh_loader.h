@@ -125,6 +125,15 @@ struct MeshSizeEstimate {
 // extension, header counts the file cannot hold).
 MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path);
 
+// An upper bound of what an OBJ's or STL's estimate can count against a budget (the cached copy,
+// the world copy and the BVH: 96 B per vertex, 46 B per triangle) per byte of the file: a counted
+// `v` line takes at least 2 bytes ("v" and its newline), an `f` line of c corners at least 2c + 2
+// for its c − 2 triangles, an ASCII STL `facet` line 6, a binary STL triangle 50. MeshCache skips
+// the estimate's scan of the file when kMeshBudgetBytesPerFileByte × size + one vertex
+// (kMeshBudgetSlackBytes, for a last line without its newline) already fits the budget.
+inline constexpr double kMeshBudgetBytesPerFileByte = 48;
+inline constexpr double kMeshBudgetSlackBytes = 96;
+
 // Bytes of one copy of a mesh (positions, normals, indices) of that size.
 double meshCopyBytes(double triangles, double vertices);
 

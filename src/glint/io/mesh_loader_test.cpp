@@ -22,6 +22,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "glint/core/bounds.h"
@@ -378,6 +379,105 @@ TEST(MeshLoader, GeneratedNormalsAreSmoothBelowTheCreaseAngle) {
     EXPECT_NEAR(part.normals[v].y, expected.y, 1e-6);
     EXPECT_NEAR(part.normals[v].z, expected.z, 1e-6);
   }
+}
+
+// ------------------------------------------------------------------------------ joined vertices
+
+// The icosahedron of icosahedronObj as ASCII STL: 20 facets of three vertices each, stored apart
+// (STL has no shared vertices), with facet normals glint discards.
+std::string icosahedronStl() {
+  std::istringstream obj(icosahedronObj());
+  std::vector<std::string> vertices;
+  std::ostringstream stl;
+  stl << "solid ico\n";
+  std::string line;
+  while (std::getline(obj, line)) {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (keyword == "v") vertices.push_back(line.substr(2));
+    if (keyword != "f") continue;
+    stl << "facet normal 0 0 0\nouter loop\n";
+    std::size_t index = 0;
+    while (words >> index) stl << "vertex " << vertices.at(index - 1) << "\n";
+    stl << "endloop\nendfacet\n";
+  }
+  stl << "endsolid ico\n";
+  return stl.str();
+}
+
+TEST(MeshLoader, DeindexedStlCornersAreJoinedIntoSharedVertices) {
+  // 60 corners in the file at 12 distinct positions, every corner's generated normal the smooth
+  // one (the icosahedron's dihedral angles are below the crease angle): 12 shared vertices, the
+  // same as the indexed OBJ of the same solid.
+  TempDir dir;
+  const MeshFile stl = readMeshFile(dir.write("icosahedron.stl", icosahedronStl()));
+  expectWellFormed(stl);
+  ASSERT_EQ(stl.parts.size(), 1u);
+  EXPECT_EQ(stl.parts[0].triangleCount(), 20u);
+  EXPECT_EQ(stl.parts[0].positions.size(), 12u);
+  EXPECT_EQ(stl.droppedTriangles, 0u);
+  const MeshFile obj = readMeshFile(dir.write("icosahedron.obj", icosahedronObj()));
+  ASSERT_EQ(obj.parts.size(), 1u);
+  // The same vertices in the same order (first use by the triangles, which are in the same order).
+  ASSERT_EQ(obj.parts[0].positions.size(), 12u);
+  for (std::size_t v = 0; v < 12; ++v) {
+    EXPECT_NEAR(distance(stl.parts[0].positions[v], obj.parts[0].positions[v]), 0, 1e-6);
+    EXPECT_NEAR(length(toVec(stl.parts[0].normals[v]) - toVec(obj.parts[0].normals[v])), 0, 1e-6);
+  }
+  EXPECT_EQ(stl.parts[0].indices, obj.parts[0].indices);
+}
+
+TEST(MeshLoader, CreasesKeepOneVertexPerNormal) {
+  // A unit cube of 8 positions and 6 quads, without normals. Every 90° edge is a crease (beyond
+  // the 80° crease angle), so each position carries three generated normals, one per face around
+  // it: 24 vertices, each with its face's normal.
+  TempDir dir;
+  const MeshFile file = readMeshFile(
+      dir.write("cube.obj",
+                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"));
+  expectWellFormed(file);
+  ASSERT_EQ(file.parts.size(), 1u);
+  const TriangleMesh& part = file.parts[0];
+  EXPECT_EQ(part.triangleCount(), 12u);
+  EXPECT_EQ(part.positions.size(), 24u);
+  std::map<std::tuple<double, double, double>, int> normalsAt;
+  for (const Point3& p : part.positions) ++normalsAt[{p.x, p.y, p.z}];
+  EXPECT_EQ(normalsAt.size(), 8u);
+  for (const auto& [position, normals] : normalsAt) EXPECT_EQ(normals, 3);
+  for (std::size_t t = 0; t < part.triangleCount(); ++t) {
+    const std::uint32_t* i = &part.indices[3 * t];
+    const Vec3 face = normalize(cross(part.positions[i[1]] - part.positions[i[0]],
+                                      part.positions[i[2]] - part.positions[i[0]]));
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(dot(face, part.normals[i[k]]), 1, 1e-6);
+  }
+}
+
+TEST(MeshLoader, SeamsOfSplitNormalsKeepBothNormals) {
+  // Two triangles hinged on the edge of vertices 2 and 3. In `seam` each triangle gives the
+  // shared edge its own normal (`vn`): the edge's two positions carry two normals each, so 6
+  // vertices. In `smooth` both use one normal: 4 vertices. Corners that differ only in a texture
+  // coordinate (glint does not use them) or in the sign of a zero coordinate are one vertex.
+  TempDir dir;
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 1\nvt 0 0\nvt 1 1\n";
+  const MeshFile seam = readMeshFile(
+      dir.write("seam.obj", v + "vn 0 0 1\nvn 0 1 0\nf 1//1 2//1 3//1\nf 2//2 4//2 3//2\n"));
+  ASSERT_EQ(seam.parts.size(), 1u);
+  EXPECT_EQ(seam.parts[0].positions.size(), 6u);
+  const std::vector<std::uint32_t> seamIndices{0, 1, 2, 3, 4, 5};
+  EXPECT_EQ(seam.parts[0].indices, seamIndices);
+  EXPECT_EQ(seam.parts[0].normals[1], Normal3(0, 0, 1));
+  EXPECT_EQ(seam.parts[0].normals[3], Normal3(0, 1, 0));
+  EXPECT_EQ(seam.parts[0].positions[1], seam.parts[0].positions[3]);
+
+  const MeshFile smooth = readMeshFile(
+      dir.write("smooth.obj", v + "v -0 0 -0\nvn 0 0 1\nf 5/1/1 2/1/1 3/1/1\nf 2/2/1 4/2/1 3/1/1\n"
+                                  "f 1/2/1 3/1/1 2/2/1\n"));
+  ASSERT_EQ(smooth.parts.size(), 1u);
+  EXPECT_EQ(smooth.parts[0].positions.size(), 4u);
+  const std::vector<std::uint32_t> smoothIndices{0, 1, 2, 1, 3, 2, 0, 2, 1};
+  EXPECT_EQ(smooth.parts[0].indices, smoothIndices);
 }
 
 // ------------------------------------------------------------------------------------------- STL
@@ -840,6 +940,50 @@ TEST(MeshLoader, SizeEstimatesFromHeadersAndCounts) {
   // Unreadable files fail as readMeshFile would.
   EXPECT_THROW(estimateMeshSize(dir.path() / "none.obj"), MeshLoadError);
   EXPECT_THROW(estimateMeshSize(dir.write("x.dae", "")), MeshLoadError);
+}
+
+TEST(MeshLoader, TheFileSizeBoundsEveryEstimate) {
+  // MeshCache skips the scan when kMeshBudgetBytesPerFileByte × size + kMeshBudgetSlackBytes fits
+  // the budget: that must bound what the estimate would count for the densest files possible.
+  TempDir dir;
+  const auto budgetBytes = [](const MeshSizeEstimate& e) {
+    const double t = static_cast<double>(e.triangles);
+    return 2 * meshCopyBytes(t, static_cast<double>(e.vertices)) + kBvhBytesPerTriangle * t;
+  };
+  const auto bound = [](const fs::path& file) {
+    return kMeshBudgetBytesPerFileByte * static_cast<double>(fs::file_size(file)) +
+           kMeshBudgetSlackBytes;
+  };
+  std::string vertices;
+  for (int i = 0; i < 1000; ++i) vertices += "v\n";
+  std::string fans;
+  for (int corners = 3; corners < 200; ++corners) {
+    fans += "f";
+    for (int k = 0; k < corners; ++k) fans += " 1";
+    fans += "\n";
+  }
+  std::string facets;
+  for (int i = 0; i < 1000; ++i) facets += "facet\n";
+  const fs::path spider = kModels / "STL/Spider_binary.stl";
+  ASSERT_TRUE(installed(spider));
+  for (const fs::path& file :
+       {dir.write("v.obj", vertices + "v"), dir.write("f.obj", fans + "f 1 1 1"),
+        dir.write("mixed.obj", vertices + fans), dir.write("a.stl", facets + "facet"), spider}) {
+    const MeshSizeEstimate estimate = estimateMeshSize(file);
+    EXPECT_GT(estimate.triangles + estimate.vertices, 0u) << file;
+    EXPECT_LE(budgetBytes(estimate), bound(file)) << file;
+  }
+  // Vertex lines alone reach it: the factor is not loose.
+  const fs::path dense = dir.write("dense.obj", vertices);
+  EXPECT_DOUBLE_EQ(budgetBytes(estimateMeshSize(dense)) + kMeshBudgetSlackBytes, bound(dense));
+
+  // With a budget the bound fits, the cache still counts the real sizes of what it read.
+  const fs::path obj = dir.write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  MeshCache cache;
+  ASSERT_EQ(cache.load(obj, MeshBudget{std::uint64_t{1} << 30, 0})->triangleCount(), 1u);
+  EXPECT_DOUBLE_EQ(cache.meshBytes(), 2 * meshCopyBytes(1, 3) + kBvhBytesPerTriangle);
+  EXPECT_THROW(cache.load(dir.path() / "none.obj", MeshBudget{std::uint64_t{1} << 30, 0}),
+               MeshLoadError);
 }
 
 TEST(MeshLoader, TheMemoryEstimateRefusesBeforeReadingAndCountsEveryInstance) {
