@@ -411,6 +411,53 @@ std::size_t dropInvalidFaces(aiScene& scene) {
   return dropped;
 }
 
+// Gives every face corner of a mesh without normals its own vertex, before GenSmoothNormals.
+// That step first stores each face's normal at its vertices — a vertex shared by several faces
+// keeps only the last one — and then averages the normals of the vertices at the same position
+// within the crease angle. Indexed files (PLY, glTF) share a vertex among all faces around it, so a
+// smooth surface got one face's normal per vertex (faceted, lopsided shading) and a crease could
+// not be kept. One vertex per corner, as assimp's OBJ and STL importers already give, lets every
+// corner average exactly the faces within the crease angle; glint's join (joinMesh) shares them
+// again afterwards. Texture coordinates and colours are dropped (glint reads neither); meshes
+// with bones are left alone (their weights index the vertices).
+void splitSharedCorners(aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    aiMesh* mesh = scene.mMeshes[m];
+    if (mesh == nullptr || mesh->mNormals != nullptr || mesh->mVertices == nullptr ||
+        mesh->mNumBones != 0 || mesh->mNumAnimMeshes != 0) {
+      continue;
+    }
+    std::uint64_t corners = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) corners += mesh->mFaces[f].mNumIndices;
+    if (corners == mesh->mNumVertices || corners > kMaxMeshTriangles * 3) continue;
+    auto* vertices = new aiVector3D[corners];
+    unsigned next = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      aiFace& face = mesh->mFaces[f];
+      for (unsigned i = 0; i < face.mNumIndices; ++i) {
+        vertices[next] = mesh->mVertices[face.mIndices[i]];  // checked by dropInvalidFaces
+        face.mIndices[i] = next++;
+      }
+    }
+    delete[] mesh->mVertices;
+    mesh->mVertices = vertices;
+    mesh->mNumVertices = next;
+    delete[] mesh->mTangents;
+    mesh->mTangents = nullptr;
+    delete[] mesh->mBitangents;
+    mesh->mBitangents = nullptr;
+    for (auto*& colors : mesh->mColors) {
+      delete[] colors;
+      colors = nullptr;
+    }
+    for (unsigned k = 0; k < AI_MAX_NUMBER_OF_TEXTURECOORDS; ++k) {
+      delete[] mesh->mTextureCoords[k];
+      mesh->mTextureCoords[k] = nullptr;
+      mesh->mNumUVComponents[k] = 0;
+    }
+  }
+}
+
 std::size_t facesWithTriangles(const aiScene& scene) {
   std::size_t n = 0;
   for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
@@ -679,6 +726,7 @@ MeshFile importMesh(const std::filesystem::path& path, const std::string& extens
     if (scene == nullptr) throw MeshLoadError(assimpReason(importer.GetErrorString()));
     // The importer owns the scene and its steps edit it in place; so does dropInvalidFaces.
     result.droppedTriangles = dropInvalidFaces(const_cast<aiScene&>(*scene));
+    splitSharedCorners(const_cast<aiScene&>(*scene));
     if (scene->mRootNode == nullptr || facesWithTriangles(*scene) == 0) {
       throw MeshLoadError(result.droppedTriangles > 0
                               ? fmt::format("all {} triangles have vertex indices out of range",

@@ -322,9 +322,15 @@ TEST(MeshLoader, GeneratedNormalsKeepEdgesSharperThanTheCreaseAngle) {
   expectWellFormed(file);
   EXPECT_EQ(file.triangleCount(), 12u);  // 6 faces of 4 corners in the file
   expectBounds(boundsOf(file.parts), {{0, 0, 0}, {1, 1, 1}}, 0);
+  // And each corner carries the normal of its own face, not that of another face around the
+  // shared vertex of the file: 8 positions, three normals each.
   for (const TriangleMesh& part : file.parts) {
-    for (const Normal3& n : part.normals) {
-      EXPECT_NEAR(std::abs(n.x) + std::abs(n.y) + std::abs(n.z), 1, 1e-6);
+    EXPECT_EQ(part.positions.size(), 24u);
+    for (std::size_t t = 0; t < part.triangleCount(); ++t) {
+      const std::uint32_t* i = &part.indices[3 * t];
+      const Vec3 face = normalize(cross(part.positions[i[1]] - part.positions[i[0]],
+                                        part.positions[i[2]] - part.positions[i[0]]));
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(dot(face, part.normals[i[k]]), 1, 1e-6);
     }
   }
 }
@@ -378,6 +384,49 @@ TEST(MeshLoader, GeneratedNormalsAreSmoothBelowTheCreaseAngle) {
     EXPECT_NEAR(part.normals[v].x, expected.x, 1e-6);
     EXPECT_NEAR(part.normals[v].y, expected.y, 1e-6);
     EXPECT_NEAR(part.normals[v].z, expected.z, 1e-6);
+  }
+}
+
+// The icosahedron of icosahedronObj as an indexed ASCII PLY without normals: 12 shared vertices.
+std::string icosahedronPly() {
+  std::istringstream obj(icosahedronObj());
+  std::vector<std::string> vertices;
+  std::vector<std::string> faces;
+  std::string line;
+  while (std::getline(obj, line)) {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (keyword == "v") vertices.push_back(line.substr(2));
+    if (keyword != "f") continue;
+    std::size_t a = 0, b = 0, c = 0;
+    words >> a >> b >> c;
+    faces.push_back("3 " + std::to_string(a - 1) + " " + std::to_string(b - 1) + " " +
+                    std::to_string(c - 1));
+  }
+  std::ostringstream ply;
+  ply << "ply\nformat ascii 1.0\nelement vertex " << vertices.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << faces.size()
+      << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const std::string& v : vertices) ply << v << "\n";
+  for (const std::string& f : faces) ply << f << "\n";
+  return ply.str();
+}
+
+TEST(MeshLoader, IndexedFilesWithoutNormalsGetSmoothNormalsPerVertex) {
+  // The same icosahedron, but indexed (PLY shares each vertex among its five faces): the generated
+  // normal of a vertex must still average all five faces (the vertex direction), not keep the
+  // normal of whichever face came last.
+  TempDir dir;
+  const MeshFile file = readMeshFile(dir.write("icosahedron.ply", icosahedronPly()));
+  expectWellFormed(file);
+  ASSERT_EQ(file.parts.size(), 1u);
+  const TriangleMesh& part = file.parts[0];
+  EXPECT_EQ(part.triangleCount(), 20u);
+  ASSERT_EQ(part.positions.size(), 12u);
+  for (std::size_t v = 0; v < part.positions.size(); ++v) {
+    const Vec3 expected = normalize(toVec(part.positions[v]));
+    EXPECT_NEAR(dot(toVec(part.normals[v]), expected), 1, 1e-6) << "vertex " << v;
   }
 }
 
