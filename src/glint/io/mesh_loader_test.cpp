@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -387,29 +388,41 @@ TEST(MeshLoader, GeneratedNormalsAreSmoothBelowTheCreaseAngle) {
   }
 }
 
-// The icosahedron of icosahedronObj as an indexed ASCII PLY without normals: 12 shared vertices.
-std::string icosahedronPly() {
-  std::istringstream obj(icosahedronObj());
+// The vertex lines (coordinates as written) and 0-based faces of icosahedronObj, for writing the
+// same solid in other formats.
+struct IcosahedronText {
   std::vector<std::string> vertices;
-  std::vector<std::string> faces;
+  std::vector<std::array<std::size_t, 3>> faces;
+};
+IcosahedronText icosahedronText() {
+  IcosahedronText out;
+  std::istringstream obj(icosahedronObj());
   std::string line;
   while (std::getline(obj, line)) {
     std::istringstream words(line);
     std::string keyword;
     words >> keyword;
-    if (keyword == "v") vertices.push_back(line.substr(2));
+    if (keyword == "v") out.vertices.push_back(line.substr(2));
     if (keyword != "f") continue;
-    std::size_t a = 0, b = 0, c = 0;
-    words >> a >> b >> c;
-    faces.push_back("3 " + std::to_string(a - 1) + " " + std::to_string(b - 1) + " " +
-                    std::to_string(c - 1));
+    std::array<std::size_t, 3> face{};
+    for (std::size_t& index : face) {
+      words >> index;
+      --index;
+    }
+    out.faces.push_back(face);
   }
+  return out;
+}
+
+// The icosahedron of icosahedronObj as an indexed ASCII PLY without normals: 12 shared vertices.
+std::string icosahedronPly() {
+  const IcosahedronText ico = icosahedronText();
   std::ostringstream ply;
-  ply << "ply\nformat ascii 1.0\nelement vertex " << vertices.size()
-      << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << faces.size()
+  ply << "ply\nformat ascii 1.0\nelement vertex " << ico.vertices.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << ico.faces.size()
       << "\nproperty list uchar int vertex_indices\nend_header\n";
-  for (const std::string& v : vertices) ply << v << "\n";
-  for (const std::string& f : faces) ply << f << "\n";
+  for (const std::string& v : ico.vertices) ply << v << "\n";
+  for (const auto& f : ico.faces) ply << "3 " << f[0] << " " << f[1] << " " << f[2] << "\n";
   return ply.str();
 }
 
@@ -435,20 +448,12 @@ TEST(MeshLoader, IndexedFilesWithoutNormalsGetSmoothNormalsPerVertex) {
 // The icosahedron of icosahedronObj as ASCII STL: 20 facets of three vertices each, stored apart
 // (STL has no shared vertices), with facet normals glint discards.
 std::string icosahedronStl() {
-  std::istringstream obj(icosahedronObj());
-  std::vector<std::string> vertices;
+  const IcosahedronText ico = icosahedronText();
   std::ostringstream stl;
   stl << "solid ico\n";
-  std::string line;
-  while (std::getline(obj, line)) {
-    std::istringstream words(line);
-    std::string keyword;
-    words >> keyword;
-    if (keyword == "v") vertices.push_back(line.substr(2));
-    if (keyword != "f") continue;
+  for (const auto& face : ico.faces) {
     stl << "facet normal 0 0 0\nouter loop\n";
-    std::size_t index = 0;
-    while (words >> index) stl << "vertex " << vertices.at(index - 1) << "\n";
+    for (const std::size_t index : face) stl << "vertex " << ico.vertices.at(index) << "\n";
     stl << "endloop\nendfacet\n";
   }
   stl << "endsolid ico\n";
