@@ -16,6 +16,8 @@
 #include <string>
 #include <utility>
 
+#include "glint/core/ulp.h"
+
 namespace glint {
 
 namespace {
@@ -37,14 +39,6 @@ constexpr std::size_t kTriangleChunk = 4096;
 // (Ize 2013, "Robust BVH Ray Traversal", for the argument). The origin's own rounding to float is
 // absolute, not relative, so it is not padded but rounded toward the safe side per slab plane.
 constexpr double kFarScale = 1 + 0x1p-20;
-
-// The neighbours of a finite float toward −inf and +inf (std::nextafter without the library call).
-inline float nextDown(float f) {
-  if (f == 0) return -std::numeric_limits<float>::denorm_min();
-  const auto bits = std::bit_cast<std::uint32_t>(f);
-  return std::bit_cast<float>(f > 0 ? bits - 1 : bits + 1);
-}
-inline float nextUp(float f) { return -nextDown(-f); }
 
 // The float nearest to x on the side toward −inf (floatBelow) or +inf (floatAbove); infinite beyond
 // the float range.

@@ -18,6 +18,7 @@
 #include "glint/core/sampling.h"
 #include "glint/core/spawn.h"
 #include "glint/core/transform.h"
+#include "glint/core/ulp.h"
 #include "glint/core/vec.h"
 
 namespace glint {
@@ -484,20 +485,23 @@ TEST(CoreSpawn, OffsetMovesToTheSideOfTheNewDirectionByABoundedAmount) {
   EXPECT_EQ(r.origin, offsetRayOrigin(p, n, {0, 1, 1}));
 }
 
-TEST(CoreSpawn, NextDoubleStepsExactlyAsNextafter) {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  constexpr double kMax = std::numeric_limits<double>::max();
-  constexpr double kTiny = std::numeric_limits<double>::denorm_min();
-  constexpr double kMinNormal = std::numeric_limits<double>::min();
-  for (const double x : {0.0, -0.0, kTiny, -kTiny, kMinNormal, -kMinNormal, 1.0, -1.0, 0.1, -3e-300,
-                         2e6, -2e6, 1e300, kMax, -kMax}) {
-    EXPECT_EQ(std::bit_cast<std::uint64_t>(nextDoubleUp(x)),
-              std::bit_cast<std::uint64_t>(std::nextafter(x, kInf)))
-        << x;
-    EXPECT_EQ(std::bit_cast<std::uint64_t>(nextDoubleDown(x)),
-              std::bit_cast<std::uint64_t>(std::nextafter(x, -kInf)))
-        << x;
+// nextUp/nextDown (core/ulp.h) agree bit for bit with std::nextafter toward ±inf.
+template <class T, class Bits>
+void expectStepsAsNextafter() {
+  constexpr T kInf = std::numeric_limits<T>::infinity();
+  constexpr T kMax = std::numeric_limits<T>::max();
+  constexpr T kTiny = std::numeric_limits<T>::denorm_min();
+  constexpr T kMinNormal = std::numeric_limits<T>::min();
+  for (const T x : {T(0), T(-0.0), kTiny, -kTiny, kMinNormal, -kMinNormal, T(1), T(-1), T(0.1),
+                    T(-3e-30), T(2e6), T(-2e6), T(1e30), kMax, -kMax}) {
+    EXPECT_EQ(std::bit_cast<Bits>(nextUp(x)), std::bit_cast<Bits>(std::nextafter(x, kInf))) << x;
+    EXPECT_EQ(std::bit_cast<Bits>(nextDown(x)), std::bit_cast<Bits>(std::nextafter(x, -kInf))) << x;
   }
+}
+
+TEST(CoreUlp, NextUpAndDownStepExactlyAsNextafter) {
+  expectStepsAsNextafter<double, std::uint64_t>();
+  expectStepsAsNextafter<float, std::uint32_t>();
 }
 
 }  // namespace

@@ -2,12 +2,11 @@
 #pragma once
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
-#include <cstdint>
 #include <limits>
 
 #include "glint/core/ray.h"
+#include "glint/core/ulp.h"
 #include "glint/core/vec.h"
 
 namespace glint {
@@ -38,15 +37,6 @@ constexpr double gammaBound(int n) {
   return n * u / (1 - n * u);
 }
 
-// The next double above x toward +inf (std::nextafter(x, +inf) for finite x, without the library
-// call: it runs three times per spawned ray). −0 and +0 both step to the smallest subnormal.
-inline double nextDoubleUp(double x) {
-  if (x == 0) return std::numeric_limits<double>::denorm_min();
-  const auto bits = std::bit_cast<std::uint64_t>(x);
-  return std::bit_cast<double>(x > 0 ? bits + 1 : bits - 1);
-}
-inline double nextDoubleDown(double x) { return -nextDoubleUp(-x); }
-
 // Moves the hit point p (per-coordinate error bound pError) off its surface along the geometric
 // unit normal n, to the side the direction w leaves toward (the +n side when w is tangent).
 inline Point3 offsetRayOrigin(const Point3& p, const Vec3& pError, const Normal3& n,
@@ -59,8 +49,8 @@ inline Point3 offsetRayOrigin(const Point3& p, const Vec3& pError, const Normal3
   // One ulp further away from the surface on every axis the normal has a component along: covers
   // the rounding of the addition above, and moves the origin even when pError is 0 (box faces).
   for (int axis = 0; axis < 3; ++axis) {
-    if (along[axis] > 0) o[axis] = nextDoubleUp(o[axis]);
-    if (along[axis] < 0) o[axis] = nextDoubleDown(o[axis]);
+    if (along[axis] > 0) o[axis] = nextUp(o[axis]);
+    if (along[axis] < 0) o[axis] = nextDown(o[axis]);
   }
   return o;
 }
