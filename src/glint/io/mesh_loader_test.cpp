@@ -367,6 +367,23 @@ std::string icosahedronObj() {
   return obj.str();
 }
 
+// The icosahedron of icosahedronObj as loaded with generated smooth normals: 20 triangles over 12
+// shared vertices, each with the direction of the vertex itself as its normal (by symmetry, the
+// average of the five faces around it).
+void expectIcosahedronWithVertexNormals(const MeshFile& file) {
+  expectWellFormed(file);
+  ASSERT_EQ(file.parts.size(), 1u);
+  const TriangleMesh& part = file.parts[0];
+  EXPECT_EQ(part.triangleCount(), 20u);
+  ASSERT_EQ(part.positions.size(), 12u);  // shared: one normal per vertex
+  for (std::size_t v = 0; v < part.positions.size(); ++v) {
+    const Vec3 expected = normalize(toVec(part.positions[v]));
+    EXPECT_NEAR(part.normals[v].x, expected.x, 1e-6) << "vertex " << v;
+    EXPECT_NEAR(part.normals[v].y, expected.y, 1e-6) << "vertex " << v;
+    EXPECT_NEAR(part.normals[v].z, expected.z, 1e-6) << "vertex " << v;
+  }
+}
+
 TEST(MeshLoader, GeneratedNormalsAreSmoothBelowTheCreaseAngle) {
   // A regular icosahedron without normals. Around a vertex, the five face normals are at most
   // 70.5° apart (< 80°), so every corner's normal averages all five, which by symmetry gives the
@@ -374,18 +391,7 @@ TEST(MeshLoader, GeneratedNormalsAreSmoothBelowTheCreaseAngle) {
   TempDir dir;
   const std::string text = icosahedronObj();
   ASSERT_EQ(std::count(text.begin(), text.end(), 'f'), 20);
-  const MeshFile file = readMeshFile(dir.write("icosahedron.obj", text));
-  expectWellFormed(file);
-  ASSERT_EQ(file.parts.size(), 1u);
-  const TriangleMesh& part = file.parts[0];
-  EXPECT_EQ(part.triangleCount(), 20u);
-  EXPECT_EQ(part.positions.size(), 12u);  // shared: one normal per vertex
-  for (std::size_t v = 0; v < part.positions.size(); ++v) {
-    const Vec3 expected = normalize(toVec(part.positions[v]));
-    EXPECT_NEAR(part.normals[v].x, expected.x, 1e-6);
-    EXPECT_NEAR(part.normals[v].y, expected.y, 1e-6);
-    EXPECT_NEAR(part.normals[v].z, expected.z, 1e-6);
-  }
+  expectIcosahedronWithVertexNormals(readMeshFile(dir.write("icosahedron.obj", text)));
 }
 
 // The vertex lines (coordinates as written) and 0-based faces of icosahedronObj, for writing the
@@ -431,16 +437,7 @@ TEST(MeshLoader, IndexedFilesWithoutNormalsGetSmoothNormalsPerVertex) {
   // normal of a vertex must still average all five faces (the vertex direction), not keep the
   // normal of whichever face came last.
   TempDir dir;
-  const MeshFile file = readMeshFile(dir.write("icosahedron.ply", icosahedronPly()));
-  expectWellFormed(file);
-  ASSERT_EQ(file.parts.size(), 1u);
-  const TriangleMesh& part = file.parts[0];
-  EXPECT_EQ(part.triangleCount(), 20u);
-  ASSERT_EQ(part.positions.size(), 12u);
-  for (std::size_t v = 0; v < part.positions.size(); ++v) {
-    const Vec3 expected = normalize(toVec(part.positions[v]));
-    EXPECT_NEAR(dot(toVec(part.normals[v]), expected), 1, 1e-6) << "vertex " << v;
-  }
+  expectIcosahedronWithVertexNormals(readMeshFile(dir.write("icosahedron.ply", icosahedronPly())));
 }
 
 // ------------------------------------------------------------------------------ joined vertices
