@@ -1,6 +1,8 @@
 #include "glint/io/mesh_loader.h"
 
 #include <fcntl.h>
+#include <poll.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -8,8 +10,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <new>
@@ -220,9 +224,13 @@ MeshSizeEstimate checkPlyHeader(const std::string& header, std::uint64_t size) {
   bool ended = false;
   std::string declared;
   while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
     std::istringstream words(line);
-    std::string keyword;
-    words >> keyword;
+    // The keyword ends where assimp's PLY reader ends it: at a space or tab, or the line's end.
+    // (istream's >> also stops at \v and \f; assimp then never sees its "end_header" and loops,
+    // a fuzzing finding.)
+    const std::string keyword = line.substr(0, line.find_first_of(" \t"));
+    words.ignore(static_cast<std::streamsize>(keyword.size()));
     if (keyword == "format") {
       std::string format;
       words >> format;
@@ -857,12 +865,28 @@ bool writeMeshFile(int fd, const MeshFile& file) {
 }
 
 // Reads what the child sent, refusing anything inconsistent.
+// Reads the child's answer, waiting at most until `deadline` for it: a reader that loops (as
+// assimp's importers have on malformed files) must not hang glint.
 class Reader {
  public:
-  explicit Reader(int fd) : fd_(fd) {}
+  Reader(int fd, std::chrono::steady_clock::time_point deadline) : fd_(fd), deadline_(deadline) {}
+  bool timedOut() const { return timedOut_; }
   void bytes(void* data, std::size_t size) {
     char* p = static_cast<char*>(data);
     while (size > 0) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+          deadline_ - std::chrono::steady_clock::now());
+      pollfd ready{fd_, POLLIN, 0};
+      const int polled = left.count() > 0 ? ::poll(&ready, 1,
+                                                   static_cast<int>(std::min<std::int64_t>(
+                                                       left.count(), std::int64_t{1} << 30)))
+                                          : 0;
+      if (polled < 0 && errno == EINTR) continue;
+      if (polled == 0) {
+        timedOut_ = true;
+        throw MeshLoadError("invalid file: the mesh library did not finish reading it within " +
+                            formatSeconds(deadline_ - started_));
+      }
       const ssize_t n = ::read(fd_, p, size);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) throw MeshLoadError("invalid file: the mesh reader stopped before its answer");
@@ -893,7 +917,13 @@ class Reader {
   }
 
  private:
+  static std::string formatSeconds(std::chrono::steady_clock::duration d) {
+    return fmt::format("{:.0f} s", std::chrono::duration<double>(d).count());
+  }
   int fd_;
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point deadline_;
+  bool timedOut_ = false;
 };
 
 MeshFile receiveMeshFile(Reader& in) {
@@ -930,9 +960,20 @@ MeshFile receiveMeshFile(Reader& in) {
   return file;
 }
 
+// How long the child may take: kMeshReadBaseSeconds plus kMeshReadSecondsPerMiB per MiB of the
+// file — assimp reads a 85 MB OBJ in ~2.5 s here, so the limit only ends a reader that loops.
+std::chrono::steady_clock::duration meshReadTimeLimit(const std::filesystem::path& path) {
+  std::error_code error;
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  const double mib = error ? 0 : static_cast<double>(size) / (1024.0 * 1024.0);
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(kMeshReadBaseSeconds + kMeshReadSecondsPerMiB * mib));
+}
+
 MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw MeshLoadError(systemReason(errno));
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
     const int error = errno;
@@ -942,6 +983,9 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
   }
   if (pid == 0) {
     // The child: no destructor, atexit handler or stdio flush of the parent's state runs here.
+    // It dies with glint (killed or interrupted while loading), never left looping on its own.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(0);  // the parent was already gone
     ::close(fds[0]);
     try {
       writeMeshFile(fds[1], importMesh(path, extension));
@@ -955,8 +999,8 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
   ::close(fds[1]);
   std::optional<MeshFile> file;
   std::string failure;
+  Reader in(fds[0], std::chrono::steady_clock::now() + meshReadTimeLimit(path));
   try {
-    Reader in(fds[0]);
     file = receiveMeshFile(in);
   } catch (const MeshLoadError& e) {
     failure = e.what();
@@ -964,9 +1008,11 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
     failure = "not enough memory to load it";
   }
   ::close(fds[0]);  // a child still writing gets EPIPE and ends
+  if (in.timedOut()) ::kill(pid, SIGKILL);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
+  if (in.timedOut()) throw MeshLoadError(failure);
   // SIGPIPE: the child was still writing when the parent stopped reading an inconsistent answer.
   if (WIFSIGNALED(status) && WTERMSIG(status) != SIGPIPE) {
     throw MeshLoadError(fmt::format(

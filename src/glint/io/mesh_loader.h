@@ -25,6 +25,11 @@ namespace glint {
 // normals and indices in double precision that is already 10–20 GiB). Beyond it the file is a
 // mistake or the wrong machine, refused before glint copies the data.
 inline constexpr std::uint64_t kMaxMeshTriangles = std::uint64_t{1} << 28;
+// A mesh file is read by assimp in a child process, which may take kMeshReadBaseSeconds plus
+// kMeshReadSecondsPerMiB per MiB of the file; past that it is stopped and the file refused (an
+// importer that loops on a malformed file must not hang glint).
+inline constexpr double kMeshReadBaseSeconds = 30;
+inline constexpr double kMeshReadSecondsPerMiB = 2;
 
 // Crease angle of generated smooth normals (degrees; assimp's GenSmoothNormals): the normal at a
 // corner of a triangle averages the normals of the triangles around that vertex whose normals are
