@@ -1296,7 +1296,7 @@ std::shared_ptr<const MeshFile> MeshCache::read(const std::filesystem::path& key
   }
   ++filesRead_;
   try {
-    auto file = std::make_shared<MeshFile>(readMeshFile(path));
+    auto file = std::make_shared<const MeshFile>(readMeshFile(path));
     entries_[key] = {file, {}};
     return file;
   } catch (const MeshLoadError& e) {
@@ -1306,33 +1306,12 @@ std::shared_ptr<const MeshFile> MeshCache::read(const std::filesystem::path& key
 }
 
 std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path) {
-  const std::filesystem::path key = keyOf(path);
-  countLoad(key);
-  return read(key, path);
-}
-
-void MeshCache::expect(const std::filesystem::path& path) { ++expected_[keyOf(path)]; }
-
-void MeshCache::countLoad(const std::filesystem::path& key) {
-  if (const auto it = expected_.find(key); it != expected_.end() && it->second > 0) --it->second;
-}
-
-std::shared_ptr<MeshFile> MeshCache::take(const std::filesystem::path& path) {
-  const std::filesystem::path key = keyOf(path);
-  const auto expected = expected_.find(key);
-  if (expected == expected_.end() || expected->second != 0) return nullptr;
-  const auto entry = entries_.find(key);
-  if (entry == entries_.end() || !entry->second.file) return nullptr;
-  std::shared_ptr<MeshFile> file = std::move(entry->second.file);
-  entries_.erase(entry);
-  expected_.erase(expected);
-  return file;
+  return read(keyOf(path), path);
 }
 
 std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path,
                                                 const MeshBudget& budget) {
   const std::filesystem::path key = keyOf(path);
-  countLoad(key);
   const auto it = entries_.find(key);
   if (it != entries_.end() && !it->second.file) throw MeshLoadError(it->second.error);
   const bool cached = it != entries_.end();
@@ -1398,28 +1377,17 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
   return file;
 }
 
-namespace {
-
-// Whether the transform mirrors (negative determinant of its linear part).
-bool mirrors(const std::optional<Transform>& worldFromFile) {
-  if (!worldFromFile) return false;
-  const auto& m = worldFromFile->matrix().m;
-  const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-  return det < 0;
-}
-
-void reverseWinding(std::vector<std::uint32_t>& indices) {
-  for (std::size_t i = 0; i + 2 < indices.size(); i += 3) std::swap(indices[i + 1], indices[i + 2]);
-}
-
-}  // namespace
-
 std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
                                           const std::optional<Transform>& worldFromFile,
                                           bool smooth) {
-  const bool mirror = mirrors(worldFromFile);
+  bool mirror = false;
+  if (worldFromFile) {
+    const auto& m = worldFromFile->matrix().m;
+    const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                       m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                       m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    mirror = det < 0;
+  }
   std::vector<TriangleMesh> out;
   out.reserve(file.parts.size());
   for (const TriangleMesh& part : file.parts) {
@@ -1427,7 +1395,11 @@ std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
     mesh.materialIndex = part.materialIndex;
     mesh.emission = part.emission;
     mesh.indices = part.indices;
-    if (mirror) reverseWinding(mesh.indices);
+    if (mirror) {
+      for (std::size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
+        std::swap(mesh.indices[i + 1], mesh.indices[i + 2]);
+      }
+    }
     if (!worldFromFile) {
       mesh.positions = part.positions;
       if (smooth) mesh.normals = part.normals;
@@ -1440,33 +1412,6 @@ std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
         for (const Normal3& n : part.normals) mesh.normals.push_back(normalize(t(n)));
       }
     }
-    out.push_back(std::move(mesh));
-  }
-  return out;
-}
-
-// No copy: a 100k-triangle mesh's 3.6 MB were copied (and their pages faulted in) while the cached
-// file held the same arrays until the scene was built.
-std::vector<TriangleMesh> instantiateMesh(MeshFile&& file,
-                                          const std::optional<Transform>& worldFromFile,
-                                          bool smooth) {
-  const bool mirror = mirrors(worldFromFile);
-  std::vector<TriangleMesh> out;
-  out.reserve(file.parts.size());
-  for (TriangleMesh& part : file.parts) {
-    TriangleMesh mesh;
-    mesh.materialIndex = part.materialIndex;
-    mesh.emission = part.emission;
-    mesh.indices = std::move(part.indices);
-    if (mirror) reverseWinding(mesh.indices);
-    mesh.positions = std::move(part.positions);
-    if (smooth) mesh.normals = std::move(part.normals);
-    if (worldFromFile) {
-      const Transform& t = *worldFromFile;
-      for (Point3& p : mesh.positions) p = t(p);
-      for (Normal3& n : mesh.normals) n = normalize(t(n));
-    }
-    part = TriangleMesh{};  // whatever was not moved (unused normals) is freed now
     out.push_back(std::move(mesh));
   }
   return out;

@@ -172,25 +172,16 @@ class MeshCache {
   std::size_t filesRead() const { return filesRead_; }
   // Estimated bytes of every mesh loaded with a budget so far: cached files, world copies, BVH.
   double meshBytes() const { return meshBytes_; }
-  // Announces one more load of `path` to come (a mesh object), so that the last one may take the
-  // file out of the cache instead of copying it.
-  void expect(const std::filesystem::path& path);
-  // After the last announced load of `path`: the file, no longer in the cache, for the caller to
-  // move its parts from (instantiateMesh(MeshFile&&)); a later load would read it again. Null while
-  // announced loads remain, when none was announced, or when the file did not load.
-  std::shared_ptr<MeshFile> take(const std::filesystem::path& path);
 
  private:
   struct Entry {
-    std::shared_ptr<MeshFile> file;
+    std::shared_ptr<const MeshFile> file;
     std::string error;  // when file is null
   };
-  void countLoad(const std::filesystem::path& key);
   static std::filesystem::path keyOf(const std::filesystem::path& path);
   std::shared_ptr<const MeshFile> read(const std::filesystem::path& key,
                                        const std::filesystem::path& path);
   std::map<std::filesystem::path, Entry> entries_;
-  std::map<std::filesystem::path, std::size_t> expected_;  // announced loads still to come
   std::size_t filesRead_ = 0;
   double meshBytes_ = 0;
 };
@@ -202,11 +193,6 @@ class MeshCache {
 // dropped (flat shading). Material indices and emission are copied from the file; the caller maps
 // them onto the scene's materials.
 std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
-                                          const std::optional<Transform>& worldFromFile,
-                                          bool smooth);
-// The same, moving the parts' arrays out of `file` (transformed in place) instead of copying them;
-// file.materials stay.
-std::vector<TriangleMesh> instantiateMesh(MeshFile&& file,
                                           const std::optional<Transform>& worldFromFile,
                                           bool smooth);
 

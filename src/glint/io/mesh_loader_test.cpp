@@ -799,58 +799,7 @@ TEST(MeshLoader, MirroringTransformKeepsGeometricAndVertexNormalsOnOneSide) {
   }
 }
 
-TEST(MeshLoader, MovingInstanceEqualsTheCopyingOne) {
-  const fs::path obj = kModels / "OBJ/cube_usemtl.obj";
-  ASSERT_TRUE(installed(obj));
-  const MeshFile file = readMeshFile(obj);
-  ASSERT_GT(file.parts.size(), 1u);
-  const std::optional<Transform> transforms[] = {
-      std::nullopt, Transform::translate({1, 2, 3}) * Transform::scale(2, 1, 1),
-      Transform::scale(-1, 2, 1)};  // the last mirrors
-  for (const std::optional<Transform>& t : transforms) {
-    for (const bool smooth : {true, false}) {
-      const std::vector<TriangleMesh> copied = instantiateMesh(file, t, smooth);
-      MeshFile moved = file;
-      const std::vector<TriangleMesh> taken = instantiateMesh(std::move(moved), t, smooth);
-      ASSERT_EQ(taken.size(), copied.size());
-      for (std::size_t i = 0; i < taken.size(); ++i) {
-        EXPECT_EQ(taken[i].positions, copied[i].positions);  // bit for bit
-        EXPECT_EQ(taken[i].normals, copied[i].normals);
-        EXPECT_EQ(taken[i].indices, copied[i].indices);
-        EXPECT_EQ(taken[i].materialIndex, copied[i].materialIndex);
-        EXPECT_EQ(moved.parts[i].positions.capacity(), 0u);  // nothing left behind
-        EXPECT_EQ(moved.parts[i].normals.capacity(), 0u);
-      }
-      EXPECT_EQ(moved.materials.size(), file.materials.size());  // the materials stay
-    }
-  }
-}
-
 // ------------------------------------------------------------------------------ cache and errors
-
-TEST(MeshLoader, TheLastAnnouncedLoadTakesTheFileOutOfTheCache) {
-  const fs::path obj = kModels / "OBJ/cube_usemtl.obj";
-  ASSERT_TRUE(installed(obj));
-  MeshCache cache;
-  EXPECT_EQ(cache.take(obj), nullptr);  // nothing announced, nothing loaded
-  cache.expect(obj);
-  cache.expect(kModels / "OBJ/./cube_usemtl.obj");  // the same file
-  const auto first = cache.load(obj);
-  EXPECT_EQ(cache.take(obj), nullptr);  // one announced load still to come
-  const auto second = cache.load(obj);
-  EXPECT_EQ(first.get(), second.get());
-  const std::shared_ptr<MeshFile> taken = cache.take(obj);
-  EXPECT_EQ(taken.get(), second.get());
-  EXPECT_EQ(cache.take(obj), nullptr);  // taken once
-  EXPECT_EQ(cache.filesRead(), 1u);
-  // An unannounced load after that reads the file again.
-  EXPECT_NE(cache.load(obj).get(), taken.get());
-  EXPECT_EQ(cache.filesRead(), 2u);
-  // A file that failed is never taken.
-  cache.expect(kModels / "OBJ/no_such_file.obj");
-  EXPECT_THROW(cache.load(kModels / "OBJ/no_such_file.obj"), MeshLoadError);
-  EXPECT_EQ(cache.take(kModels / "OBJ/no_such_file.obj"), nullptr);
-}
 
 TEST(MeshLoader, CacheReadsEachFileOnce) {
   const fs::path obj = kModels / "OBJ/cube_usemtl.obj";

@@ -76,12 +76,6 @@ class Builder {
     buildAmbient();
     buildCamera();
     buildMaterials();
-    // Every mesh object's file announced first: the last object using a file takes it out of the
-    // cache instead of copying it.
-    for (const ObjectDescription& object : d_.objects) {
-      if (object.type == ShapeType::Mesh && object.file)
-        meshCache_.expect(meshPath(object.file->value));
-    }
     for (const ObjectDescription& object : d_.objects) buildObject(object);
     for (const LightDescription& light : d_.lights) buildLight(light);
     warnIfUnlit();
@@ -640,12 +634,6 @@ class Builder {
     return indices;
   }
 
-  // A mesh object's file as written, relative to the scene file's folder.
-  std::filesystem::path meshPath(const std::string& name) const {
-    const std::filesystem::path written(name);
-    return written.is_relative() ? d_.baseDirectory / written : written;
-  }
-
   // A mesh object (DESIGN.md §5, §7): its file read once per scene through meshCache_, instanced
   // with the object's transform. The object's `material` replaces every material of the file
   // (their emission too); its `emission` replaces the files' emission. A file that cannot be
@@ -663,7 +651,7 @@ class Builder {
     if (!o.complete || !name || errorCount() != errorsBefore) return;
 
     const std::filesystem::path written(*name);
-    const std::filesystem::path path = meshPath(*name);
+    const std::filesystem::path path = written.is_relative() ? d_.baseDirectory / written : written;
     std::shared_ptr<const MeshFile> file;
     try {
       // Estimated (mesh + BVH, with the film) against the memory limit before anything is read.
@@ -695,15 +683,7 @@ class Builder {
                                    file->droppedTriangles == 1 ? "" : "s", triangles));
     }
     const bool smooth = o.smooth ? o.smooth->value : true;
-    std::vector<TriangleMesh> meshes;
-    if (std::shared_ptr<MeshFile> owned = meshCache_.take(path)) {
-      meshes = instantiateMesh(std::move(*owned), worldFromFile, smooth);
-      // Kept (its materials, the parts emptied) so that no later file reuses its address, the key
-      // of fileMaterials_.
-      takenFiles_.push_back(std::move(owned));
-    } else {
-      meshes = instantiateMesh(*file, worldFromFile, smooth);
-    }
+    std::vector<TriangleMesh> meshes = instantiateMesh(*file, worldFromFile, smooth);
     const std::vector<std::uint32_t>* scene = overridesMaterial ? nullptr : &fileMaterials(*file);
     for (TriangleMesh& mesh : meshes) {
       const MeshMaterial& own = file->materials[mesh.materialIndex];
@@ -882,8 +862,7 @@ class Builder {
   std::map<std::string, SourceLocation> materialWhere_;
   MeshCache meshCache_;  // each mesh file read once per scene
   std::map<const MeshFile*, std::vector<std::uint32_t>> fileMaterials_;
-  std::vector<std::shared_ptr<MeshFile>> takenFiles_;  // out of meshCache_, parts moved out
-  std::uint64_t meshTriangles_ = 0;                    // in parts_.meshes
+  std::uint64_t meshTriangles_ = 0;  // in parts_.meshes
 };
 
 }  // namespace
