@@ -139,6 +139,25 @@ bool planeParameter(const Point3& point, const Normal3& n, const Ray& ray, doubl
 
 bool inOpenRange(double t, double tMin, double tMax) { return t > tMin && t < tMax; }
 
+// Whether the quotient num/den can be > 0, decided from the signs alone: a quotient of operands of
+// opposite signs (or a zero, or a NaN numerator) is ≤ 0 or NaN and can never lie in an interval
+// (tMin, tMax) with tMin ≥ 0. Exact — it only skips a division whose result the range test would
+// reject.
+bool positiveQuotientPossible(double num, double den) {
+  return (num > 0 && den > 0) || (num < 0 && den < 0);
+}
+
+// Whether the sphere (or the tube's cross-section) relative to the ray origin, f = origin − centre,
+// lies wholly behind the ray: the origin is outside or on it (|f|² − r² ≥ 0) and the ray does not
+// move toward the centre (−f·d ≤ 0, −0 included). quadricRoots returns then, in floating point as
+// well, roots t0 = c/q and t1 = q/a with q = b − √Δ < 0, c ≥ 0 and a > 0, both ≤ 0 (or NaN), so no
+// root lies in (tMin, tMax) when tMin ≥ 0. Shadow and reflection rays leaving a sphere meet this
+// case for the sphere they leave; deciding it here skips the root computation (a square root and
+// three divisions).
+bool wholeQuadricBehind(double b, double c, double tMin) {
+  return tMin >= 0 && std::signbit(b) && c >= 0;
+}
+
 // --- hit points with error bounds (core/spawn.h states the policy these serve) ---
 // Each bound covers the rounding of the reprojected point itself and the error with which the
 // intersection routine of the same shape, run again from a point near it, decides which side of
@@ -256,6 +275,7 @@ Sphere Sphere::make(const Point3& center, double radius) {
 
 bool Sphere::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
   const Vec3 f = ray.origin - center;
+  if (wholeQuadricBehind(-dot(f, ray.direction), dot(f, f) - radius * radius, tMin)) return false;
   double t0;
   double t1;
   if (!quadricRoots(f, ray.direction, radius, t0, t1)) return false;
@@ -279,9 +299,11 @@ bool Sphere::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) 
 }
 
 int Sphere::crossings(const Ray& ray, double tMin, double tMax) const {
+  const Vec3 f = ray.origin - center;
+  if (wholeQuadricBehind(-dot(f, ray.direction), dot(f, f) - radius * radius, tMin)) return 0;
   double t0;
   double t1;
-  if (!quadricRoots(ray.origin - center, ray.direction, radius, t0, t1)) return 0;
+  if (!quadricRoots(f, ray.direction, radius, t0, t1)) return 0;
   return int{inOpenRange(t0, tMin, tMax)} + int{inOpenRange(t1, tMin, tMax)};
 }
 
@@ -303,9 +325,26 @@ Plane Plane::fromPoints(const Point3& a, const Point3& b, const Point3& c) {
   return Plane{a, nonCollinearNormal("points", a, b, c)};
 }
 
+namespace {
+
+// The plane's ray parameter when it lies in (tMin, tMax): planeParameter and the range test, with
+// the division skipped where the signs already put t ≤ 0 (the ray leaves the plane's side it
+// starts on, as every shadow ray from above a ground plane does).
+bool planeCrossing(const Point3& point, const Normal3& n, const Ray& ray, double tMin, double tMax,
+                   double& t) {
+  const double nDotD = dot(n, ray.direction);
+  const double num = dot(n, point - ray.origin);
+  if (tMin >= 0 && !positiveQuotientPossible(num, nDotD)) return false;
+  if (isParallel(n, ray.direction, nDotD)) return false;
+  t = num / nDotD;
+  return inOpenRange(t, tMin, tMax);
+}
+
+}  // namespace
+
 bool Plane::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
   double t;
-  if (!planeParameter(point, normal, ray, t) || !inOpenRange(t, tMin, tMax)) return false;
+  if (!planeCrossing(point, normal, ray, tMin, tMax, t)) return false;
   hit.t = t;
   hit.normal = normal;
   planeHitPoint(ray, t, point, normal, 0, hit);
@@ -313,8 +352,8 @@ bool Plane::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) c
 }
 
 int Plane::crossings(const Ray& ray, double tMin, double tMax) const {
-  ShapeHit hit;
-  return intersect(ray, tMin, tMax, hit) ? 1 : 0;
+  double t;
+  return planeCrossing(point, normal, ray, tMin, tMax, t) ? 1 : 0;
 }
 
 Bounds3 Plane::bounds() const { return Bounds3::unbounded(); }
