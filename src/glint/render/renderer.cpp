@@ -157,8 +157,16 @@ Color directLight(const TraceContext& ctx, const ShadingPoint& sp, const SampleS
   // Nothing for a light to act on: skip the shadow rays too.
   if (isBlack(sp.material.kd) && !sp.hasSpecular) return sum;
   const std::vector<Light>& lights = ctx.scene.lights();
-  for (std::size_t i = 0; i < lights.size(); ++i) {
+  const std::size_t lightCount = lights.size();
+  for (std::size_t i = 0; i < lightCount; ++i) {
     const Light& light = lights[i];
+    // Point lights (the common case) inline: no call and no LightSample through memory.
+    if (const auto* point = std::get_if<PointLight>(&light)) {
+      const LightSample sample = illuminate(*point, sp.p);
+      if (isBlack(sample.intensity)) continue;
+      sum += shadeLightSample(ctx, sp, sample, &point->position);
+      continue;
+    }
     if (const auto* area = std::get_if<AreaLight>(&light)) {
       sum += areaLightTerm(ctx, sp, *area, kFirstLightDimension + static_cast<std::uint32_t>(i),
                            stream, split);
@@ -386,8 +394,12 @@ Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column,
   // The key and the two camera dimensions are the same for every sample of the pixel.
   const SampleStream pixel = SampleStream::forPixel(static_cast<std::uint32_t>(column),
                                                     static_cast<std::uint32_t>(row), 0, seed);
-  const SobolDimension2D offsets = pixel.dimension(kPixelDimension);
-  const SobolDimension2D lens = pixel.dimension(kLensDimension);
+  // Dimensions nobody reads are not drawn: the pixel offset of an unjittered sample (the pixel
+  // centre) and the lens point of a pinhole camera (generateRay ignores it).
+  const bool lensed = camera.hasLens();
+  const SobolDimension2D offsets =
+      plan.jitter ? pixel.dimension(kPixelDimension) : SobolDimension2D(0);
+  const SobolDimension2D lens = lensed ? pixel.dimension(kLensDimension) : SobolDimension2D(0);
   Color sum;
   Color sumSquares;
   std::uint32_t n = 0;
@@ -396,7 +408,8 @@ Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column,
     for (; n < target; ++n) {
       const SampleStream stream(pixel.key(), n);
       const Point2 offset = plan.jitter ? offsets.at(n) : Point2{0.5, 0.5};
-      const Ray ray = camera.generateRay(column, row, offset, lens.at(n));
+      const Ray ray =
+          camera.generateRay(column, row, offset, lensed ? lens.at(n) : Point2{0.5, 0.5});
       Color value = traceCameraRay(ctx, ray, stream);
       if (!isFinite(value)) {
         value = Color{};

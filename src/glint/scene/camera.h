@@ -47,6 +47,9 @@ class Camera {
   double viewPlaneWidth() const { return width_; }
   double viewPlaneHeight() const { return height_; }
   double viewPlaneDistance() const { return distance_; }
+  // Whether generateRay reads its lensSample (a thin lens, aperture > 0); a pinhole camera ignores
+  // it, so callers may skip drawing one.
+  bool hasLens() const { return aperture_ > 0; }
 
  private:
   Point3 position_;
