@@ -210,7 +210,8 @@ void boxHitPoint(const Ray& ray, double t, int axis, double face, ShapeHit& hit)
 // catastrophically for distant rays, and the root pair from q = b + sign(b)·√Δ
 // (t0 = c/q, t1 = q/a), which avoids subtracting nearly equal numbers. A tangent line (Δ ≤ 0) has
 // no roots.
-bool quadricRoots(const Vec3& f, const Vec3& d, double r, double& t0, double& t1) {
+[[gnu::always_inline]] inline bool quadricRoots(const Vec3& f, const Vec3& d, double r, double& t0,
+                                                double& t1) {
   const double a = dot(d, d);
   const double b = -dot(f, d);
   const Vec3 closest = f + d * (b / a);  // centre-to-line offset at the closest approach
@@ -273,7 +274,15 @@ Sphere Sphere::make(const Point3& center, double radius) {
   return Sphere{center, requirePositive("radius", radius)};
 }
 
-bool Sphere::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
+namespace {
+
+// The bodies of Sphere::intersect and Sphere::crossings, inlined there and into Primitive's path
+// for untransformed spheres and planes, the common primitives: no call through the variant
+// dispatch per candidate.
+[[gnu::always_inline]] inline bool sphereIntersect(const Sphere& sphere, const Ray& ray,
+                                                   double tMin, double tMax, ShapeHit& hit) {
+  const Point3& center = sphere.center;
+  const double radius = sphere.radius;
   const Vec3 f = ray.origin - center;
   if (wholeQuadricBehind(-dot(f, ray.direction), dot(f, f) - radius * radius, tMin)) return false;
   double t0;
@@ -298,13 +307,26 @@ bool Sphere::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) 
   return true;
 }
 
-int Sphere::crossings(const Ray& ray, double tMin, double tMax) const {
+[[gnu::always_inline]] inline int sphereCrossings(const Sphere& sphere, const Ray& ray, double tMin,
+                                                  double tMax) {
+  const Point3& center = sphere.center;
+  const double radius = sphere.radius;
   const Vec3 f = ray.origin - center;
   if (wholeQuadricBehind(-dot(f, ray.direction), dot(f, f) - radius * radius, tMin)) return 0;
   double t0;
   double t1;
   if (!quadricRoots(f, ray.direction, radius, t0, t1)) return 0;
   return int{inOpenRange(t0, tMin, tMax)} + int{inOpenRange(t1, tMin, tMax)};
+}
+
+}  // namespace
+
+bool Sphere::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
+  return sphereIntersect(*this, ray, tMin, tMax, hit);
+}
+
+int Sphere::crossings(const Ray& ray, double tMin, double tMax) const {
+  return sphereCrossings(*this, ray, tMin, tMax);
 }
 
 Bounds3 Sphere::bounds() const {
@@ -330,8 +352,9 @@ namespace {
 // The plane's ray parameter when it lies in (tMin, tMax): planeParameter and the range test, with
 // the division skipped where the signs already put t ≤ 0 (the ray leaves the plane's side it
 // starts on, as every shadow ray from above a ground plane does).
-bool planeCrossing(const Point3& point, const Normal3& n, const Ray& ray, double tMin, double tMax,
-                   double& t) {
+[[gnu::always_inline]] inline bool planeCrossing(const Point3& point, const Normal3& n,
+                                                 const Ray& ray, double tMin, double tMax,
+                                                 double& t) {
   const double nDotD = dot(n, ray.direction);
   const double num = dot(n, point - ray.origin);
   if (tMin >= 0 && !positiveQuotientPossible(num, nDotD)) return false;
@@ -340,20 +363,30 @@ bool planeCrossing(const Point3& point, const Normal3& n, const Ray& ray, double
   return inOpenRange(t, tMin, tMax);
 }
 
-}  // namespace
-
-bool Plane::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
+[[gnu::always_inline]] inline bool planeIntersect(const Plane& plane, const Ray& ray, double tMin,
+                                                  double tMax, ShapeHit& hit) {
   double t;
-  if (!planeCrossing(point, normal, ray, tMin, tMax, t)) return false;
+  if (!planeCrossing(plane.point, plane.normal, ray, tMin, tMax, t)) return false;
   hit.t = t;
-  hit.normal = normal;
-  planeHitPoint(ray, t, point, normal, 0, hit);
+  hit.normal = plane.normal;
+  planeHitPoint(ray, t, plane.point, plane.normal, 0, hit);
   return true;
 }
 
-int Plane::crossings(const Ray& ray, double tMin, double tMax) const {
+[[gnu::always_inline]] inline int planeCrossings(const Plane& plane, const Ray& ray, double tMin,
+                                                 double tMax) {
   double t;
-  return planeCrossing(point, normal, ray, tMin, tMax, t) ? 1 : 0;
+  return planeCrossing(plane.point, plane.normal, ray, tMin, tMax, t) ? 1 : 0;
+}
+
+}  // namespace
+
+bool Plane::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
+  return planeIntersect(*this, ray, tMin, tMax, hit);
+}
+
+int Plane::crossings(const Ray& ray, double tMin, double tMax) const {
+  return planeCrossings(*this, ray, tMin, tMax);
 }
 
 Bounds3 Plane::bounds() const { return Bounds3::unbounded(); }
@@ -937,8 +970,13 @@ Primitive::Primitive(Shape shape, std::uint32_t materialIndex, const Color& emis
 }
 
 bool Primitive::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
-  if (!worldFromObject_)
+  if (!worldFromObject_) {
+    if (const auto* sphere = std::get_if<Sphere>(&shape_))
+      return sphereIntersect(*sphere, ray, tMin, tMax, hit);
+    if (const auto* plane = std::get_if<Plane>(&shape_))
+      return planeIntersect(*plane, ray, tMin, tMax, hit);
     return std::visit([&](const auto& s) { return s.intersect(ray, tMin, tMax, hit); }, shape_);
+  }
   // The object-space direction is deliberately not normalised, so t is the same in both spaces.
   const Ray objectRay = objectRayOf(*worldFromObject_, ray);
   if (!std::visit([&](const auto& s) { return s.intersect(objectRay, tMin, tMax, hit); }, shape_))
@@ -951,7 +989,15 @@ bool Primitive::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hi
 }
 
 int Primitive::crossings(const Ray& ray, double tMin, double tMax) const {
-  const Ray objectRay = worldFromObject_ ? objectRayOf(*worldFromObject_, ray) : ray;
+  // Untransformed (the common case): the shape reads the caller's ray, no copy.
+  if (!worldFromObject_) {
+    if (const auto* sphere = std::get_if<Sphere>(&shape_))
+      return sphereCrossings(*sphere, ray, tMin, tMax);
+    if (const auto* plane = std::get_if<Plane>(&shape_))
+      return planeCrossings(*plane, ray, tMin, tMax);
+    return std::visit([&](const auto& s) { return s.crossings(ray, tMin, tMax); }, shape_);
+  }
+  const Ray objectRay = objectRayOf(*worldFromObject_, ray);
   return std::visit([&](const auto& s) { return s.crossings(objectRay, tMin, tMax); }, shape_);
 }
 
