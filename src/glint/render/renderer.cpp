@@ -58,6 +58,10 @@ struct TraceContext {
   int maxDepth;
   double minWeight;
   std::uint32_t blurSamples;
+  // One Hit per path depth (maxDepth of them), owned by the caller: trace() at depth d fills
+  // hits[d], which stays valid while its child rays run. Reused rather than a fresh Hit per call,
+  // whose 120 bytes of default initialisation (rep stos) cost more than the rest of a miss.
+  Hit* hits;
 };
 
 enum class SecondaryKind { Reflection, Refraction };
@@ -242,7 +246,8 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
 // `split` whether the path has already fanned out into several glossy rays, `stream` its samples.
 Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split,
             const SampleStream& stream) {
-  Hit hit;
+  // Aggregate::intersect sets every field of a hit it reports; a miss reads nothing.
+  Hit& hit = ctx.hits[depth];
   if (!ctx.scene.intersect(ray, kInfinity, hit)) return ctx.scene.background();
   const int hitDepth = depth + 1;
 
@@ -307,10 +312,19 @@ Color traceCameraRay(const TraceContext& ctx, const Ray& ray, const SampleStream
   return trace(ctx, Ray{ray.origin, normalize(ray.direction)}, 0, Color(1), false, stream);
 }
 
-TraceContext makeContext(const Scene& scene, RayCounts& counts) {
+// The per-depth hits a TraceContext points into (one allocation per tile, not per ray).
+std::vector<Hit> hitStorage(const Scene& scene) {
+  return std::vector<Hit>(static_cast<std::size_t>(std::max(scene.render().maxDepth, 1)));
+}
+
+TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>& hits) {
   const RenderSettings& settings = scene.render();
-  return TraceContext{scene, counts, settings.maxDepth, settings.minWeight,
-                      static_cast<std::uint32_t>(std::max(settings.blurSamples, 1))};
+  return TraceContext{scene,
+                      counts,
+                      settings.maxDepth,
+                      settings.minWeight,
+                      static_cast<std::uint32_t>(std::max(settings.blurSamples, 1)),
+                      hits.data()};
 }
 
 PixelRegion validatedRegion(const Scene& scene, const RenderOptions& options) {
@@ -349,6 +363,9 @@ struct SamplingPlan {
   double threshold = 0;       // adaptive: the standard error to reach, linear color units
   bool adaptive = false;
   bool jitter = false;  // false: the single sample goes through the pixel centre (DESIGN.md §4)
+  // Whether any sample dimension is ever drawn (jitter, a lens, an area light, a glossy lobe).
+  // Without one the pixel's stream key is never read, and its hash is skipped.
+  bool drawsSamples = true;
 };
 
 SamplingPlan samplingPlan(const ImageSettings& image) {
@@ -366,6 +383,20 @@ SamplingPlan samplingPlan(const ImageSettings& image) {
     plan.threshold = image.adaptive->threshold;
   }
   return plan;
+}
+
+// Whether a render of `scene` under `plan` reads any sampler dimension (see the layout at the top
+// of this file): a jittered pixel offset, a thin lens, an area light or a glossy lobe.
+// Conservative: a blurred material counts even where its lobe is never traced.
+bool drawsSamples(const Scene& scene, const SamplingPlan& plan) {
+  if (plan.jitter || scene.camera().hasLens()) return true;
+  for (const Light& light : scene.lights()) {
+    if (std::holds_alternative<AreaLight>(light)) return true;
+  }
+  for (const Material& material : scene.materials()) {
+    if (material.reflectionBlur > 0 || material.refractionBlur > 0) return true;
+  }
+  return false;
 }
 
 // The largest per-channel standard error of the mean of n samples with sums Σx and Σx²:
@@ -391,9 +422,12 @@ double standardError(const Color& sum, const Color& sumSquares, std::uint32_t n)
 Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
                   std::uint64_t seed, std::uint64_t& nonFinite) {
   const Camera& camera = ctx.scene.camera();
-  // The key and the two camera dimensions are the same for every sample of the pixel.
-  const SampleStream pixel = SampleStream::forPixel(static_cast<std::uint32_t>(column),
-                                                    static_cast<std::uint32_t>(row), 0, seed);
+  // The key and the two camera dimensions are the same for every sample of the pixel. A render
+  // that draws no sample never reads the key: its hash is skipped.
+  const SampleStream pixel = plan.drawsSamples
+                                 ? SampleStream::forPixel(static_cast<std::uint32_t>(column),
+                                                          static_cast<std::uint32_t>(row), 0, seed)
+                                 : SampleStream();
   // Dimensions nobody reads are not drawn: the pixel offset of an unjittered sample (the pixel
   // centre) and the lens point of a pinhole camera (generateRay ignores it).
   const bool lensed = camera.hasLens();
@@ -430,7 +464,8 @@ Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column,
 Color traceRay(const Scene& scene, const Ray& ray, Rng& rng, RayCounts* counts) {
   RayCounts local;
   RayCounts& target = counts ? *counts : local;
-  const TraceContext ctx = makeContext(scene, target);
+  std::vector<Hit> hits = hitStorage(scene);
+  const TraceContext ctx = makeContext(scene, target, hits);
   return traceCameraRay(ctx, ray, SampleStream(rng.nextBits(), 0));
 }
 
@@ -462,7 +497,8 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
 
   const ImageSettings& image = scene.image();
   Film film(image.width, image.height, region);
-  const SamplingPlan plan = samplingPlan(image);
+  SamplingPlan plan = samplingPlan(image);
+  plan.drawsSamples = drawsSamples(scene, plan);
   const std::uint64_t seed = scene.render().seed;
 
   std::atomic<std::uint64_t> cameraRays{0}, shadowRays{0}, reflectionRays{0}, refractionRays{0};
@@ -503,7 +539,8 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
     const int x1 = tiles[tile].x1;
     const int y1 = tiles[tile].y1;
     RayCounts counts;
-    const TraceContext ctx = makeContext(scene, counts);
+    std::vector<Hit> hits = hitStorage(scene);
+    const TraceContext ctx = makeContext(scene, counts, hits);
     std::uint64_t tileNonFinite = 0;
     std::optional<PixelCoord> tileFirstNonFinite;
     bool abandoned = false;
