@@ -82,17 +82,44 @@ bool lightPosition(const Light& light, Point3& position) {
   return false;
 }
 
+// The origins of the rays that leave one hit. offsetRayOrigin (core/spawn.h) depends on the
+// direction only through the side of the surface it leaves toward, so the hit has at most two
+// distinct origins; each is computed once, at its first use, and shared by every shadow,
+// reflection and refraction ray toward that side (the same bits as spawnRay per ray).
+class SpawnOrigins {
+ public:
+  SpawnOrigins(const Point3& p, const Vec3& pError, const Normal3& n)
+      : p_(p), pError_(pError), n_(n) {}
+
+  // origins.spawn(w).
+  Ray spawn(const Vec3& w) {
+    const int side = dot(n_, w) >= 0 ? 1 : 0;  // offsetRayOrigin's test
+    if (!ready_[side]) {
+      origin_[side] = offsetRayOrigin(p_, pError_, n_, w);
+      ready_[side] = true;
+    }
+    return Ray{origin_[side], w};
+  }
+
+ private:
+  const Point3& p_;
+  const Vec3& pError_;
+  const Normal3& n_;
+  Point3 origin_[2];
+  bool ready_[2] = {false, false};
+};
+
 // Shading inputs at one hit that every light sample shares (references into trace()'s frame: no
 // copies per hit).
 struct ShadingPoint {
   const Material& material;
-  const Point3& p;     // on the surface (Hit::point)
-  const Vec3& pError;  // per-coordinate error bound of p (Hit::pointError), for spawnRay
-  const Normal3& n;    // geometric: side tests and shadow-ray origins
-  const Normal3& ns;   // shading (= n except on smooth meshes): diffuse term and mirror direction
-  const Vec3& v;       // unit view direction
-  double nv;           // n·v
+  const Point3& p;    // on the surface (Hit::point)
+  const Normal3& n;   // geometric: side tests and shadow-ray origins
+  const Normal3& ns;  // shading (= n except on smooth meshes): diffuse term and mirror direction
+  const Vec3& v;      // unit view direction
+  double nv;          // n·v
   bool hasSpecular;
+  SpawnOrigins& origins;  // of p, pError and n
 };
 
 // One light sample's term of DESIGN.md §3:
@@ -109,7 +136,7 @@ struct ShadingPoint {
   // The light and the eye must be on the same side of the surface.
   if (!(nl * sp.nv > 0)) return Color();
 
-  const Ray shadowRay = spawnRay(sp.p, sp.pError, sp.n, -l);
+  const Ray shadowRay = sp.origins.spawn(-l);
   const double tMax = lightPoint ? distance(shadowRay.origin, *lightPoint) : kInfinity;
   ++ctx.counts.shadow;
   const Color transmittance = ctx.scene.transmittance(shadowRay, tMax);
@@ -194,16 +221,15 @@ Color directLight(const TraceContext& ctx, const ShadingPoint& sp, const SampleS
 // marked `split`, and a split path uses a single cone ray at later glossy bounces (and fewer
 // area-light samples, see areaLightSampleCount). So a path tree holds at most blurSamples rays
 // per glossy lobe of its first glossy hit instead of blurSamples^depth.
-Color traceLobe(const TraceContext& ctx, const Point3& p, const Vec3& pError, const Normal3& n,
-                const Vec3& ideal, double blurDegrees, SecondaryKind kind, int depth,
-                const Color& weight, bool split, const SampleStream& stream) {
+Color traceLobe(const TraceContext& ctx, SpawnOrigins& origins, const Normal3& n, const Vec3& ideal,
+                double blurDegrees, SecondaryKind kind, int depth, const Color& weight, bool split,
+                const SampleStream& stream) {
   const bool reflection = kind == SecondaryKind::Reflection;
   std::uint64_t& counter = reflection ? ctx.counts.reflection : ctx.counts.refraction;
   const std::uint32_t dimension = reflection ? kReflectionDimension : kRefractionDimension;
   if (!(blurDegrees > 0)) {
     ++counter;
-    return trace(ctx, spawnRay(p, pError, n, ideal), depth, weight, split,
-                 stream.branch(dimension, 1, 0));
+    return trace(ctx, origins.spawn(ideal), depth, weight, split, stream.branch(dimension, 1, 0));
   }
   const double cosMax = std::cos(std::min(blurDegrees, 180.0) * std::numbers::pi / 180.0);
   const double idealSide = dot(n, ideal);
@@ -222,13 +248,12 @@ Color traceLobe(const TraceContext& ctx, const Point3& p, const Vec3& pError, co
     // Keep only directions that leave on the same side of the surface as the ideal one.
     if (!(dot(n, w) * idealSide > 0)) continue;
     ++counter;
-    sum += trace(ctx, spawnRay(p, pError, n, w), depth, weight, childSplit,
-                 SampleStream(childKey, index));
+    sum += trace(ctx, origins.spawn(w), depth, weight, childSplit, SampleStream(childKey, index));
     ++kept;
   }
   if (kept == 0) {
     ++counter;
-    return trace(ctx, spawnRay(p, pError, n, ideal), depth, weight, childSplit,
+    return trace(ctx, origins.spawn(ideal), depth, weight, childSplit,
                  SampleStream(childKey, stream.subIndex(count, 0)));
   }
   return sum / static_cast<double>(kept);
@@ -265,7 +290,8 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   const double nsv = dot(ns, v);
 
   Color color = ctx.scene.emissionOf(hit) + material.ka * ctx.scene.ambient();
-  color += directLight(ctx, ShadingPoint{material, p, pError, n, ns, v, nv, !isBlack(material.ks)},
+  SpawnOrigins origins(p, pError, n);
+  color += directLight(ctx, ShadingPoint{material, p, n, ns, v, nv, !isBlack(material.ks), origins},
                        stream, split);
   if (hitDepth >= ctx.maxDepth) return color;
 
@@ -277,7 +303,7 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   Color branchWeight;
   if (worthTracing(material.kr, weight, ctx.minWeight, branchWeight)) {
     color +=
-        material.kr * traceLobe(ctx, p, pError, n, reflected, material.reflectionBlur,
+        material.kr * traceLobe(ctx, origins, n, reflected, material.reflectionBlur,
                                 SecondaryKind::Reflection, hitDepth, branchWeight, split, stream);
   }
   if (worthTracing(material.kt, weight, ctx.minWeight, branchWeight)) {
@@ -299,7 +325,7 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
       }
     }
     color +=
-        material.kt * traceLobe(ctx, p, pError, n, transmitted, material.refractionBlur,
+        material.kt * traceLobe(ctx, origins, n, transmitted, material.refractionBlur,
                                 SecondaryKind::Refraction, hitDepth, branchWeight, split, stream);
   }
   return color;
