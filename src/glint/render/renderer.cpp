@@ -91,7 +91,7 @@ class SpawnOrigins {
   SpawnOrigins(const Point3& p, const Vec3& pError, const Normal3& n)
       : p_(p), pError_(pError), n_(n) {}
 
-  // origins.spawn(w).
+  // The ray spawnRay(p, pError, n, w) returns.
   Ray spawn(const Vec3& w) {
     const int side = dot(n_, w) >= 0 ? 1 : 0;  // offsetRayOrigin's test
     if (!ready_[side]) {
