@@ -139,6 +139,25 @@ bool planeParameter(const Point3& point, const Normal3& n, const Ray& ray, doubl
 
 bool inOpenRange(double t, double tMin, double tMax) { return t > tMin && t < tMax; }
 
+// Whether the quotient num/den can be > 0, decided from the signs alone: a quotient of operands of
+// opposite signs (or a zero, or a NaN numerator) is ≤ 0 or NaN and can never lie in an interval
+// (tMin, tMax) with tMin ≥ 0. Exact — it only skips a division whose result the range test would
+// reject.
+bool positiveQuotientPossible(double num, double den) {
+  return (num > 0 && den > 0) || (num < 0 && den < 0);
+}
+
+// Whether the sphere (or the tube's cross-section) relative to the ray origin, f = origin − centre,
+// lies wholly behind the ray: the origin is outside or on it (|f|² − r² ≥ 0) and the ray does not
+// move toward the centre (−f·d ≤ 0, −0 included). quadricRoots returns then, in floating point as
+// well, roots t0 = c/q and t1 = q/a with q = b − √Δ < 0, c ≥ 0 and a > 0, both ≤ 0 (or NaN), so no
+// root lies in (tMin, tMax) when tMin ≥ 0. Shadow and reflection rays leaving a sphere meet this
+// case for the sphere they leave; deciding it here skips the root computation (a square root and
+// three divisions).
+bool wholeQuadricBehind(double b, double c, double tMin) {
+  return tMin >= 0 && std::signbit(b) && c >= 0;
+}
+
 // --- hit points with error bounds (core/spawn.h states the policy these serve) ---
 // Each bound covers the rounding of the reprojected point itself and the error with which the
 // intersection routine of the same shape, run again from a point near it, decides which side of
@@ -191,7 +210,8 @@ void boxHitPoint(const Ray& ray, double t, int axis, double face, ShapeHit& hit)
 // catastrophically for distant rays, and the root pair from q = b + sign(b)·√Δ
 // (t0 = c/q, t1 = q/a), which avoids subtracting nearly equal numbers. A tangent line (Δ ≤ 0) has
 // no roots.
-bool quadricRoots(const Vec3& f, const Vec3& d, double r, double& t0, double& t1) {
+[[gnu::always_inline]] inline bool quadricRoots(const Vec3& f, const Vec3& d, double r, double& t0,
+                                                double& t1) {
   const double a = dot(d, d);
   const double b = -dot(f, d);
   const Vec3 closest = f + d * (b / a);  // centre-to-line offset at the closest approach
@@ -254,8 +274,17 @@ Sphere Sphere::make(const Point3& center, double radius) {
   return Sphere{center, requirePositive("radius", radius)};
 }
 
-bool Sphere::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
+namespace {
+
+// The bodies of Sphere::intersect and Sphere::crossings, inlined there and into Primitive's path
+// for untransformed spheres and planes, the common primitives: no call through the variant
+// dispatch per candidate.
+[[gnu::always_inline]] inline bool sphereIntersect(const Sphere& sphere, const Ray& ray,
+                                                   double tMin, double tMax, ShapeHit& hit) {
+  const Point3& center = sphere.center;
+  const double radius = sphere.radius;
   const Vec3 f = ray.origin - center;
+  if (wholeQuadricBehind(-dot(f, ray.direction), dot(f, f) - radius * radius, tMin)) return false;
   double t0;
   double t1;
   if (!quadricRoots(f, ray.direction, radius, t0, t1)) return false;
@@ -278,11 +307,26 @@ bool Sphere::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) 
   return true;
 }
 
-int Sphere::crossings(const Ray& ray, double tMin, double tMax) const {
+[[gnu::always_inline]] inline int sphereCrossings(const Sphere& sphere, const Ray& ray, double tMin,
+                                                  double tMax) {
+  const Point3& center = sphere.center;
+  const double radius = sphere.radius;
+  const Vec3 f = ray.origin - center;
+  if (wholeQuadricBehind(-dot(f, ray.direction), dot(f, f) - radius * radius, tMin)) return 0;
   double t0;
   double t1;
-  if (!quadricRoots(ray.origin - center, ray.direction, radius, t0, t1)) return 0;
+  if (!quadricRoots(f, ray.direction, radius, t0, t1)) return 0;
   return int{inOpenRange(t0, tMin, tMax)} + int{inOpenRange(t1, tMin, tMax)};
+}
+
+}  // namespace
+
+bool Sphere::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
+  return sphereIntersect(*this, ray, tMin, tMax, hit);
+}
+
+int Sphere::crossings(const Ray& ray, double tMin, double tMax) const {
+  return sphereCrossings(*this, ray, tMin, tMax);
 }
 
 Bounds3 Sphere::bounds() const {
@@ -303,18 +347,46 @@ Plane Plane::fromPoints(const Point3& a, const Point3& b, const Point3& c) {
   return Plane{a, nonCollinearNormal("points", a, b, c)};
 }
 
-bool Plane::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
+namespace {
+
+// The plane's ray parameter when it lies in (tMin, tMax): planeParameter and the range test, with
+// the division skipped where the signs already put t ≤ 0 (the ray leaves the plane's side it
+// starts on, as every shadow ray from above a ground plane does).
+[[gnu::always_inline]] inline bool planeCrossing(const Point3& point, const Normal3& n,
+                                                 const Ray& ray, double tMin, double tMax,
+                                                 double& t) {
+  const double nDotD = dot(n, ray.direction);
+  const double num = dot(n, point - ray.origin);
+  if (tMin >= 0 && !positiveQuotientPossible(num, nDotD)) return false;
+  if (isParallel(n, ray.direction, nDotD)) return false;
+  t = num / nDotD;
+  return inOpenRange(t, tMin, tMax);
+}
+
+[[gnu::always_inline]] inline bool planeIntersect(const Plane& plane, const Ray& ray, double tMin,
+                                                  double tMax, ShapeHit& hit) {
   double t;
-  if (!planeParameter(point, normal, ray, t) || !inOpenRange(t, tMin, tMax)) return false;
+  if (!planeCrossing(plane.point, plane.normal, ray, tMin, tMax, t)) return false;
   hit.t = t;
-  hit.normal = normal;
-  planeHitPoint(ray, t, point, normal, 0, hit);
+  hit.normal = plane.normal;
+  planeHitPoint(ray, t, plane.point, plane.normal, 0, hit);
   return true;
 }
 
+[[gnu::always_inline]] inline int planeCrossings(const Plane& plane, const Ray& ray, double tMin,
+                                                 double tMax) {
+  double t;
+  return planeCrossing(plane.point, plane.normal, ray, tMin, tMax, t) ? 1 : 0;
+}
+
+}  // namespace
+
+bool Plane::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
+  return planeIntersect(*this, ray, tMin, tMax, hit);
+}
+
 int Plane::crossings(const Ray& ray, double tMin, double tMax) const {
-  ShapeHit hit;
-  return intersect(ray, tMin, tMax, hit) ? 1 : 0;
+  return planeCrossings(*this, ray, tMin, tMax);
 }
 
 Bounds3 Plane::bounds() const { return Bounds3::unbounded(); }
@@ -898,8 +970,13 @@ Primitive::Primitive(Shape shape, std::uint32_t materialIndex, const Color& emis
 }
 
 bool Primitive::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
-  if (!worldFromObject_)
+  if (!worldFromObject_) {
+    if (const auto* sphere = std::get_if<Sphere>(&shape_))
+      return sphereIntersect(*sphere, ray, tMin, tMax, hit);
+    if (const auto* plane = std::get_if<Plane>(&shape_))
+      return planeIntersect(*plane, ray, tMin, tMax, hit);
     return std::visit([&](const auto& s) { return s.intersect(ray, tMin, tMax, hit); }, shape_);
+  }
   // The object-space direction is deliberately not normalised, so t is the same in both spaces.
   const Ray objectRay = objectRayOf(*worldFromObject_, ray);
   if (!std::visit([&](const auto& s) { return s.intersect(objectRay, tMin, tMax, hit); }, shape_))
@@ -912,7 +989,15 @@ bool Primitive::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hi
 }
 
 int Primitive::crossings(const Ray& ray, double tMin, double tMax) const {
-  const Ray objectRay = worldFromObject_ ? objectRayOf(*worldFromObject_, ray) : ray;
+  // Untransformed (the common case): the shape reads the caller's ray, no copy.
+  if (!worldFromObject_) {
+    if (const auto* sphere = std::get_if<Sphere>(&shape_))
+      return sphereCrossings(*sphere, ray, tMin, tMax);
+    if (const auto* plane = std::get_if<Plane>(&shape_))
+      return planeCrossings(*plane, ray, tMin, tMax);
+    return std::visit([&](const auto& s) { return s.crossings(ray, tMin, tMax); }, shape_);
+  }
+  const Ray objectRay = objectRayOf(*worldFromObject_, ray);
   return std::visit([&](const auto& s) { return s.crossings(objectRay, tMin, tMax); }, shape_);
 }
 

@@ -140,6 +140,61 @@ TEST(ShapeSphere, CrossingsCountRootsInRange) {
   EXPECT_EQ(s.crossings(ray, 7.5, 12.5), 2);
 }
 
+// A sphere wholly behind the ray (origin outside, moving away) is decided without its roots; the
+// roots still count where the range reaches back to them (tMin < 0).
+TEST(ShapeSphere, WhollyBehindOnlyHitsWithNegativeTMin) {
+  const Sphere s = Sphere::make({0, 0, 0}, 2);
+  const Ray away{{0, 0, 10}, {0, 0, 1}};
+  ShapeHit hit;
+  EXPECT_FALSE(hits(s, away, hit, 0, kInfinity));
+  EXPECT_FALSE(hits(s, away, hit, -0.0, kInfinity));
+  EXPECT_EQ(s.crossings(away, 0, kInfinity), 0);
+  EXPECT_EQ(s.crossings(away, -kInfinity, kInfinity), 2);
+  EXPECT_EQ(s.crossings(away, -9, kInfinity), 1);
+  ASSERT_TRUE(hits(s, away, hit, -20, kInfinity));
+  EXPECT_DOUBLE_EQ(hit.t, -12);
+  // Moving sideways (f·d = 0, the boundary of "away"): the line passes 10 from the centre.
+  EXPECT_EQ(s.crossings(Ray{{0, 0, 10}, {1, 0, 0}}, -kInfinity, kInfinity), 0);
+  // Sideways from inside (|f|² − r² < 0): the roots lie on both sides of the origin.
+  EXPECT_EQ(s.crossings(Ray{{0, 0, 1.5}, {1, 0, 0}}, 0, kInfinity), 1);
+}
+
+// The early-outs agree with the roots: random rays against a reference computed in long double
+// (rays whose roots come within 1e-9 of a range end are skipped, where rounding may decide).
+TEST(ShapeSphere, CrossingsMatchLongDoubleRoots) {
+  const Sphere s = Sphere::make({0.5, -1, 2}, 1.5);
+  Rng rng(7);
+  int compared = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Point3 o{6 * rng.uniform() - 2.5, 6 * rng.uniform() - 4, 6 * rng.uniform() - 1};
+    const Vec3 d{2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1};
+    const double tMin = i % 3 == 0 ? -1.0 : 0.0;
+    const long double fx = o.x - 0.5L, fy = o.y + 1.0L, fz = o.z - 2.0L;
+    const long double a = static_cast<long double>(d.x) * d.x +
+                          static_cast<long double>(d.y) * d.y + static_cast<long double>(d.z) * d.z;
+    const long double b = fx * d.x + fy * d.y + fz * d.z;
+    const long double c = fx * fx + fy * fy + fz * fz - 2.25L;
+    const long double disc = b * b - a * c;
+    int expected = 0;
+    if (disc > 1e-9L) {
+      const long double root[2] = {(-b - std::sqrt(disc)) / a, (-b + std::sqrt(disc)) / a};
+      bool near = false;
+      for (const long double t : root) {
+        near = near || std::fabs(t - tMin) < 1e-9L;
+        expected += t > tMin ? 1 : 0;
+      }
+      if (near) continue;
+    } else if (disc > -1e-9L) {
+      continue;
+    }
+    ++compared;
+    EXPECT_EQ(s.crossings(Ray{o, d}, tMin, kInfinity), expected) << "ray " << i;
+    ShapeHit hit;
+    EXPECT_EQ(s.intersect(Ray{o, d}, tMin, kInfinity, hit), expected > 0) << "ray " << i;
+  }
+  EXPECT_GT(compared, 3000);
+}
+
 TEST(ShapeSphere, DistantSphereKeepsPrecision) {
   // A radius-1 sphere 1e6 away: the naive discriminant b² − ac loses ~1e-4 to cancellation; the
   // Ray Tracing Gems form keeps t to ~1e-9.
@@ -225,6 +280,22 @@ TEST(ShapePlane, BehindAndTMax) {
   EXPECT_FALSE(hits(p, ray, hit, 5, kInfinity));
   EXPECT_EQ(p.crossings(ray, 0, kInfinity), 1);
   EXPECT_EQ(p.crossings(ray, 0, 5), 0);
+}
+
+// The division is skipped where the signs alone put t ≤ 0; a range reaching back still counts it.
+TEST(ShapePlane, SignsDecideOnlyForNonNegativeTMin) {
+  const Plane p = Plane::make({0, 0, -5}, {0, 0, 1});
+  const Ray up{{0, 0, 0}, {0, 0, 1}};  // above the plane, leaving it: t = −5
+  ShapeHit hit;
+  EXPECT_FALSE(hits(p, up, hit, 0, kInfinity));
+  EXPECT_EQ(p.crossings(up, 0, kInfinity), 0);
+  EXPECT_EQ(p.crossings(up, -0.0, kInfinity), 0);
+  EXPECT_EQ(p.crossings(up, -6, kInfinity), 1);
+  ASSERT_TRUE(hits(p, up, hit, -6, kInfinity));
+  EXPECT_DOUBLE_EQ(hit.t, -5);
+  const Ray below{{0, 0, -7}, {0, 0, -1}};  // below, leaving downward: t = −2
+  EXPECT_EQ(p.crossings(below, 0, kInfinity), 0);
+  EXPECT_EQ(p.crossings(below, -3, kInfinity), 1);
 }
 
 TEST(ShapePlane, UnboundedAndNormalAt) {

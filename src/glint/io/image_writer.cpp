@@ -27,7 +27,11 @@ std::uint8_t encodeChannel(double linear, Encoding encoding) {
   if (std::isnan(linear)) return 0;
   const double clamped = std::clamp(linear, 0.0, 1.0);
   const double encoded = encoding == Encoding::Srgb ? linearToSrgb(clamped) : clamped;
-  return static_cast<std::uint8_t>(std::lround(std::clamp(encoded, 0.0, 1.0) * 255.0));
+  // std::lround (half away from zero) of v in [0, 255], without the libm call: v − ⌊v⌋ is exact
+  // there (Sterbenz), so comparing it with 0.5 rounds exactly as lround does.
+  const double v = std::clamp(encoded, 0.0, 1.0) * 255.0;
+  const auto whole = static_cast<int>(v);
+  return static_cast<std::uint8_t>(whole + (v - whole >= 0.5 ? 1 : 0));
 }
 
 double decodeChannel(std::uint8_t code, Encoding encoding) {
@@ -114,15 +118,12 @@ void requireNonEmpty(const Film& film, const std::filesystem::path& path) {
 
 // Interleaved 8-bit RGB rows, top row first.
 std::vector<std::uint8_t> encodeRgb8(const Film& film, Encoding encoding) {
-  std::vector<std::uint8_t> bytes;
-  bytes.reserve(static_cast<std::size_t>(film.width()) * film.height() * 3);
-  for (int y = 0; y < film.height(); ++y) {
-    for (int x = 0; x < film.width(); ++x) {
-      const Color& c = film.at(x, y);
-      bytes.push_back(encodeChannel(c.r, encoding));
-      bytes.push_back(encodeChannel(c.g, encoding));
-      bytes.push_back(encodeChannel(c.b, encoding));
-    }
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(film.width()) * film.height() * 3);
+  std::uint8_t* out = bytes.data();
+  for (const Color& c : film.pixels()) {  // row-major, top row first: the file's order
+    *out++ = encodeChannel(c.r, encoding);
+    *out++ = encodeChannel(c.g, encoding);
+    *out++ = encodeChannel(c.b, encoding);
   }
   return bytes;
 }

@@ -58,6 +58,10 @@ struct TraceContext {
   int maxDepth;
   double minWeight;
   std::uint32_t blurSamples;
+  // One Hit per path depth (maxDepth of them), owned by the caller: trace() at depth d fills
+  // hits[d], which stays valid while its child rays run. Reused rather than a fresh Hit per call,
+  // whose 120 bytes of default initialisation (rep stos) cost more than the rest of a miss.
+  Hit* hits;
 };
 
 enum class SecondaryKind { Reflection, Refraction };
@@ -78,17 +82,44 @@ bool lightPosition(const Light& light, Point3& position) {
   return false;
 }
 
+// The origins of the rays that leave one hit. offsetRayOrigin (core/spawn.h) depends on the
+// direction only through the side of the surface it leaves toward, so the hit has at most two
+// distinct origins; each is computed once, at its first use, and shared by every shadow,
+// reflection and refraction ray toward that side (the same bits as spawnRay per ray).
+class SpawnOrigins {
+ public:
+  SpawnOrigins(const Point3& p, const Vec3& pError, const Normal3& n)
+      : p_(p), pError_(pError), n_(n) {}
+
+  // The ray spawnRay(p, pError, n, w) returns.
+  Ray spawn(const Vec3& w) {
+    const int side = dot(n_, w) >= 0 ? 1 : 0;  // offsetRayOrigin's test
+    if (!ready_[side]) {
+      origin_[side] = offsetRayOrigin(p_, pError_, n_, w);
+      ready_[side] = true;
+    }
+    return Ray{origin_[side], w};
+  }
+
+ private:
+  const Point3& p_;
+  const Vec3& pError_;
+  const Normal3& n_;
+  Point3 origin_[2];
+  bool ready_[2] = {false, false};
+};
+
 // Shading inputs at one hit that every light sample shares (references into trace()'s frame: no
 // copies per hit).
 struct ShadingPoint {
   const Material& material;
-  const Point3& p;     // on the surface (Hit::point)
-  const Vec3& pError;  // per-coordinate error bound of p (Hit::pointError), for spawnRay
-  const Normal3& n;    // geometric: side tests and shadow-ray origins
-  const Normal3& ns;   // shading (= n except on smooth meshes): diffuse term and mirror direction
-  const Vec3& v;       // unit view direction
-  double nv;           // n·v
+  const Point3& p;    // on the surface (Hit::point)
+  const Normal3& n;   // geometric: side tests and shadow-ray origins
+  const Normal3& ns;  // shading (= n except on smooth meshes): diffuse term and mirror direction
+  const Vec3& v;      // unit view direction
+  double nv;          // n·v
   bool hasSpecular;
+  SpawnOrigins& origins;  // of p, pError and n
 };
 
 // One light sample's term of DESIGN.md §3:
@@ -105,7 +136,7 @@ struct ShadingPoint {
   // The light and the eye must be on the same side of the surface.
   if (!(nl * sp.nv > 0)) return Color();
 
-  const Ray shadowRay = spawnRay(sp.p, sp.pError, sp.n, -l);
+  const Ray shadowRay = sp.origins.spawn(-l);
   const double tMax = lightPoint ? distance(shadowRay.origin, *lightPoint) : kInfinity;
   ++ctx.counts.shadow;
   const Color transmittance = ctx.scene.transmittance(shadowRay, tMax);
@@ -157,8 +188,16 @@ Color directLight(const TraceContext& ctx, const ShadingPoint& sp, const SampleS
   // Nothing for a light to act on: skip the shadow rays too.
   if (isBlack(sp.material.kd) && !sp.hasSpecular) return sum;
   const std::vector<Light>& lights = ctx.scene.lights();
-  for (std::size_t i = 0; i < lights.size(); ++i) {
+  const std::size_t lightCount = lights.size();
+  for (std::size_t i = 0; i < lightCount; ++i) {
     const Light& light = lights[i];
+    // Point lights (the common case) inline: no call and no LightSample through memory.
+    if (const auto* point = std::get_if<PointLight>(&light)) {
+      const LightSample sample = illuminate(*point, sp.p);
+      if (isBlack(sample.intensity)) continue;
+      sum += shadeLightSample(ctx, sp, sample, &point->position);
+      continue;
+    }
     if (const auto* area = std::get_if<AreaLight>(&light)) {
       sum += areaLightTerm(ctx, sp, *area, kFirstLightDimension + static_cast<std::uint32_t>(i),
                            stream, split);
@@ -182,16 +221,15 @@ Color directLight(const TraceContext& ctx, const ShadingPoint& sp, const SampleS
 // marked `split`, and a split path uses a single cone ray at later glossy bounces (and fewer
 // area-light samples, see areaLightSampleCount). So a path tree holds at most blurSamples rays
 // per glossy lobe of its first glossy hit instead of blurSamples^depth.
-Color traceLobe(const TraceContext& ctx, const Point3& p, const Vec3& pError, const Normal3& n,
-                const Vec3& ideal, double blurDegrees, SecondaryKind kind, int depth,
-                const Color& weight, bool split, const SampleStream& stream) {
+Color traceLobe(const TraceContext& ctx, SpawnOrigins& origins, const Normal3& n, const Vec3& ideal,
+                double blurDegrees, SecondaryKind kind, int depth, const Color& weight, bool split,
+                const SampleStream& stream) {
   const bool reflection = kind == SecondaryKind::Reflection;
   std::uint64_t& counter = reflection ? ctx.counts.reflection : ctx.counts.refraction;
   const std::uint32_t dimension = reflection ? kReflectionDimension : kRefractionDimension;
   if (!(blurDegrees > 0)) {
     ++counter;
-    return trace(ctx, spawnRay(p, pError, n, ideal), depth, weight, split,
-                 stream.branch(dimension, 1, 0));
+    return trace(ctx, origins.spawn(ideal), depth, weight, split, stream.branch(dimension, 1, 0));
   }
   const double cosMax = std::cos(std::min(blurDegrees, 180.0) * std::numbers::pi / 180.0);
   const double idealSide = dot(n, ideal);
@@ -210,13 +248,12 @@ Color traceLobe(const TraceContext& ctx, const Point3& p, const Vec3& pError, co
     // Keep only directions that leave on the same side of the surface as the ideal one.
     if (!(dot(n, w) * idealSide > 0)) continue;
     ++counter;
-    sum += trace(ctx, spawnRay(p, pError, n, w), depth, weight, childSplit,
-                 SampleStream(childKey, index));
+    sum += trace(ctx, origins.spawn(w), depth, weight, childSplit, SampleStream(childKey, index));
     ++kept;
   }
   if (kept == 0) {
     ++counter;
-    return trace(ctx, spawnRay(p, pError, n, ideal), depth, weight, childSplit,
+    return trace(ctx, origins.spawn(ideal), depth, weight, childSplit,
                  SampleStream(childKey, stream.subIndex(count, 0)));
   }
   return sum / static_cast<double>(kept);
@@ -234,7 +271,8 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
 // `split` whether the path has already fanned out into several glossy rays, `stream` its samples.
 Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split,
             const SampleStream& stream) {
-  Hit hit;
+  // Aggregate::intersect sets every field of a hit it reports; a miss reads nothing.
+  Hit& hit = ctx.hits[depth];
   if (!ctx.scene.intersect(ray, kInfinity, hit)) return ctx.scene.background();
   const int hitDepth = depth + 1;
 
@@ -252,7 +290,8 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   const double nsv = dot(ns, v);
 
   Color color = ctx.scene.emissionOf(hit) + material.ka * ctx.scene.ambient();
-  color += directLight(ctx, ShadingPoint{material, p, pError, n, ns, v, nv, !isBlack(material.ks)},
+  SpawnOrigins origins(p, pError, n);
+  color += directLight(ctx, ShadingPoint{material, p, n, ns, v, nv, !isBlack(material.ks), origins},
                        stream, split);
   if (hitDepth >= ctx.maxDepth) return color;
 
@@ -264,7 +303,7 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   Color branchWeight;
   if (worthTracing(material.kr, weight, ctx.minWeight, branchWeight)) {
     color +=
-        material.kr * traceLobe(ctx, p, pError, n, reflected, material.reflectionBlur,
+        material.kr * traceLobe(ctx, origins, n, reflected, material.reflectionBlur,
                                 SecondaryKind::Reflection, hitDepth, branchWeight, split, stream);
   }
   if (worthTracing(material.kt, weight, ctx.minWeight, branchWeight)) {
@@ -286,7 +325,7 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
       }
     }
     color +=
-        material.kt * traceLobe(ctx, p, pError, n, transmitted, material.refractionBlur,
+        material.kt * traceLobe(ctx, origins, n, transmitted, material.refractionBlur,
                                 SecondaryKind::Refraction, hitDepth, branchWeight, split, stream);
   }
   return color;
@@ -299,10 +338,19 @@ Color traceCameraRay(const TraceContext& ctx, const Ray& ray, const SampleStream
   return trace(ctx, Ray{ray.origin, normalize(ray.direction)}, 0, Color(1), false, stream);
 }
 
-TraceContext makeContext(const Scene& scene, RayCounts& counts) {
+// The per-depth hits a TraceContext points into (one allocation per tile, not per ray).
+std::vector<Hit> hitStorage(const Scene& scene) {
+  return std::vector<Hit>(static_cast<std::size_t>(std::max(scene.render().maxDepth, 1)));
+}
+
+TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>& hits) {
   const RenderSettings& settings = scene.render();
-  return TraceContext{scene, counts, settings.maxDepth, settings.minWeight,
-                      static_cast<std::uint32_t>(std::max(settings.blurSamples, 1))};
+  return TraceContext{scene,
+                      counts,
+                      settings.maxDepth,
+                      settings.minWeight,
+                      static_cast<std::uint32_t>(std::max(settings.blurSamples, 1)),
+                      hits.data()};
 }
 
 PixelRegion validatedRegion(const Scene& scene, const RenderOptions& options) {
@@ -341,6 +389,9 @@ struct SamplingPlan {
   double threshold = 0;       // adaptive: the standard error to reach, linear color units
   bool adaptive = false;
   bool jitter = false;  // false: the single sample goes through the pixel centre (DESIGN.md §4)
+  // Whether any sample dimension is ever drawn (jitter, a lens, an area light, a glossy lobe).
+  // Without one the pixel's stream key is never read, and its hash is skipped.
+  bool drawsSamples = true;
 };
 
 SamplingPlan samplingPlan(const ImageSettings& image) {
@@ -358,6 +409,20 @@ SamplingPlan samplingPlan(const ImageSettings& image) {
     plan.threshold = image.adaptive->threshold;
   }
   return plan;
+}
+
+// Whether a render of `scene` under `plan` reads any sampler dimension (see the layout at the top
+// of this file): a jittered pixel offset, a thin lens, an area light or a glossy lobe.
+// Conservative: a blurred material counts even where its lobe is never traced.
+bool drawsSamples(const Scene& scene, const SamplingPlan& plan) {
+  if (plan.jitter || scene.camera().hasLens()) return true;
+  for (const Light& light : scene.lights()) {
+    if (std::holds_alternative<AreaLight>(light)) return true;
+  }
+  for (const Material& material : scene.materials()) {
+    if (material.reflectionBlur > 0 || material.refractionBlur > 0) return true;
+  }
+  return false;
 }
 
 // The largest per-channel standard error of the mean of n samples with sums Σx and Σx²:
@@ -383,11 +448,18 @@ double standardError(const Color& sum, const Color& sumSquares, std::uint32_t n)
 Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
                   std::uint64_t seed, std::uint64_t& nonFinite) {
   const Camera& camera = ctx.scene.camera();
-  // The key and the two camera dimensions are the same for every sample of the pixel.
-  const SampleStream pixel = SampleStream::forPixel(static_cast<std::uint32_t>(column),
-                                                    static_cast<std::uint32_t>(row), 0, seed);
-  const SobolDimension2D offsets = pixel.dimension(kPixelDimension);
-  const SobolDimension2D lens = pixel.dimension(kLensDimension);
+  // The key and the two camera dimensions are the same for every sample of the pixel. A render
+  // that draws no sample never reads the key: its hash is skipped.
+  const SampleStream pixel = plan.drawsSamples
+                                 ? SampleStream::forPixel(static_cast<std::uint32_t>(column),
+                                                          static_cast<std::uint32_t>(row), 0, seed)
+                                 : SampleStream();
+  // Dimensions nobody reads are not drawn: the pixel offset of an unjittered sample (the pixel
+  // centre) and the lens point of a pinhole camera (generateRay ignores it).
+  const bool lensed = camera.hasLens();
+  const SobolDimension2D offsets =
+      plan.jitter ? pixel.dimension(kPixelDimension) : SobolDimension2D(0);
+  const SobolDimension2D lens = lensed ? pixel.dimension(kLensDimension) : SobolDimension2D(0);
   Color sum;
   Color sumSquares;
   std::uint32_t n = 0;
@@ -396,7 +468,8 @@ Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column,
     for (; n < target; ++n) {
       const SampleStream stream(pixel.key(), n);
       const Point2 offset = plan.jitter ? offsets.at(n) : Point2{0.5, 0.5};
-      const Ray ray = camera.generateRay(column, row, offset, lens.at(n));
+      const Ray ray =
+          camera.generateRay(column, row, offset, lensed ? lens.at(n) : Point2{0.5, 0.5});
       Color value = traceCameraRay(ctx, ray, stream);
       if (!isFinite(value)) {
         value = Color{};
@@ -417,7 +490,8 @@ Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column,
 Color traceRay(const Scene& scene, const Ray& ray, Rng& rng, RayCounts* counts) {
   RayCounts local;
   RayCounts& target = counts ? *counts : local;
-  const TraceContext ctx = makeContext(scene, target);
+  std::vector<Hit> hits = hitStorage(scene);
+  const TraceContext ctx = makeContext(scene, target, hits);
   return traceCameraRay(ctx, ray, SampleStream(rng.nextBits(), 0));
 }
 
@@ -449,7 +523,8 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
 
   const ImageSettings& image = scene.image();
   Film film(image.width, image.height, region);
-  const SamplingPlan plan = samplingPlan(image);
+  SamplingPlan plan = samplingPlan(image);
+  plan.drawsSamples = drawsSamples(scene, plan);
   const std::uint64_t seed = scene.render().seed;
 
   std::atomic<std::uint64_t> cameraRays{0}, shadowRays{0}, reflectionRays{0}, refractionRays{0};
@@ -490,7 +565,8 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
     const int x1 = tiles[tile].x1;
     const int y1 = tiles[tile].y1;
     RayCounts counts;
-    const TraceContext ctx = makeContext(scene, counts);
+    std::vector<Hit> hits = hitStorage(scene);
+    const TraceContext ctx = makeContext(scene, counts, hits);
     std::uint64_t tileNonFinite = 0;
     std::optional<PixelCoord> tileFirstNonFinite;
     bool abandoned = false;

@@ -83,6 +83,9 @@ Camera::Camera(const CameraSpec& spec)
     distance_ = spec.viewPlaneDistance;
   }
 
+  pitchX_ = width_ / imageWidth_;
+  pitchY_ = height_ / imageHeight_;
+
   if (spec.aperture < 0) {
     throw CameraError(fmt::format("camera aperture must be >= 0, got {}", spec.aperture));
   }
@@ -96,8 +99,8 @@ Ray Camera::generateRay(int column, int row, const Point2& pixelOffset,
                         const Point2& lensSample) const {
   // Offsets from the view-plane centre Pc = p0 + d·vTo, in scene units along vRight and vUp; the
   // pixel centre (offset 0.5) gives DESIGN.md §4's xJ = (j − (nX−1)/2)·Rx exactly.
-  const double rx = width_ / imageWidth_;
-  const double ry = height_ / imageHeight_;
+  const double rx = pitchX_;
+  const double ry = pitchY_;
   const double xj = (column + pixelOffset.x - 0.5 - (imageWidth_ - 1) / 2.0) * rx;
   const double yi = -(row + pixelOffset.y - 0.5 - (imageHeight_ - 1) / 2.0) * ry;
   // Pc + xJ·vRight + yI·vUp − p0, formed without the round trip through world positions.

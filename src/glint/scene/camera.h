@@ -47,6 +47,9 @@ class Camera {
   double viewPlaneWidth() const { return width_; }
   double viewPlaneHeight() const { return height_; }
   double viewPlaneDistance() const { return distance_; }
+  // Whether generateRay reads its lensSample (a thin lens, aperture > 0); a pinhole camera ignores
+  // it, so callers may skip drawing one.
+  bool hasLens() const { return aperture_ > 0; }
 
  private:
   Point3 position_;
@@ -54,6 +57,9 @@ class Camera {
   double width_ = 0, height_ = 0, distance_ = 0;
   double aperture_ = 0, focusDistance_ = 0;
   int imageWidth_ = 1, imageHeight_ = 1;
+  // Pixel pitch on the view plane (width_ / imageWidth_, height_ / imageHeight_), scene units:
+  // computed once instead of two divisions per camera ray.
+  double pitchX_ = 0, pitchY_ = 0;
 };
 
 }  // namespace glint

@@ -13,10 +13,7 @@ namespace glint {
 
 namespace {
 
-// 1 / (kc + kl·d + kq·d²) applied to I0; d in scene units.
-Color attenuate(const Color& intensity, const Attenuation& a, double d) {
-  return intensity / (a.kc + a.kl * d + a.kq * d * d);
-}
+using light_detail::attenuate;
 
 // l and d from a positional light to p; false when p is the light's position (l undefined).
 bool towardPoint(const Point3& lightPosition, const Point3& p, LightSample& sample) {
@@ -44,6 +41,8 @@ LightSample illuminate(const Light& light, const Point3& p) {
               l.shape == AreaShape::Rectangle ? l.corner + (l.edge1 + l.edge2) * 0.5 : l.center;
           if (!towardPoint(centre, p, sample)) return sample;
           sample.intensity = attenuate(l.intensity, l.attenuation, sample.distance);
+        } else if constexpr (std::is_same_v<T, PointLight>) {
+          return illuminate(l, p);
         } else {
           if (!towardPoint(l.position, p, sample)) return sample;  // zero intensity
           sample.intensity = attenuate(l.intensity, l.attenuation, sample.distance);

@@ -66,6 +66,26 @@ struct LightSample {
   Color intensity;      // I_L(P) before shadowing
 };
 
+namespace light_detail {
+// 1 / (kc + kl·d + kq·d²) applied to I0; d in scene units.
+inline Color attenuate(const Color& intensity, const Attenuation& a, double d) {
+  return intensity / (a.kc + a.kl * d + a.kq * d * d);
+}
+}  // namespace light_detail
+
+// illuminate() of a point light, inline for the renderer's light loop (the variant overload below
+// gives the same bits: it calls this one).
+inline LightSample illuminate(const PointLight& light, const Point3& p) {
+  LightSample sample;
+  const Vec3 offset = p - light.position;
+  const double d = length(offset);
+  if (!(d > 0)) return sample;  // P at the light: l undefined, zero intensity
+  sample.toPoint = offset / d;
+  sample.distance = d;
+  sample.intensity = light_detail::attenuate(light.intensity, light.attenuation, d);
+  return sample;
+}
+
 // I_L(P) and l for any light (DESIGN.md §3). P at the position of a point/spot light gives zero
 // intensity (l is undefined there). An area light is treated here as one point light at its centre;
 // the renderer samples its surface instead.
