@@ -14,6 +14,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "glint/core/ulp.h"
@@ -28,6 +29,7 @@ using bvh::kPrimitiveKey;
 using bvh::Node;
 
 constexpr float kFloatInf = std::numeric_limits<float>::infinity();
+constexpr float kFloatMax = std::numeric_limits<float>::max();
 // Marks a triangle reference that was left out (degenerate) before compaction; not a valid key.
 constexpr std::uint32_t kDroppedKey = 0xffffffffu;
 constexpr std::size_t kTriangleChunk = 4096;
@@ -41,21 +43,68 @@ constexpr std::size_t kTriangleChunk = 4096;
 constexpr double kFarScale = 1 + 0x1p-20;
 
 // The float nearest to x on the side toward −inf (floatBelow) or +inf (floatAbove); infinite beyond
-// the float range.
+// the float range. Branch-free (the rounding direction of x to float is a coin toss per ray, so a
+// branch there mispredicts half the time): a one-ulp step is ±1 on the bit pattern, away from zero
+// on the side of x's sign (nextUp/nextDown of core/ulp.h; −0 steps to −denorm_min, +0 to
+// +denorm_min, exactly as they do).
+inline float floatStep(float f, bool step, bool up) {
+  const auto bits = std::bit_cast<std::uint32_t>(f);
+  const std::uint32_t negative = bits >> 31;
+  // Toward +inf: +1 for a positive pattern, −1 for a negative one; toward −inf the opposite.
+  const std::uint32_t delta = (up ? 1u : 0xffffffffu) * (1u - 2u * negative);
+  return std::bit_cast<float>(bits + (step ? delta : 0u));
+}
 inline float floatBelow(double x) {
   const auto f = static_cast<float>(x);
-  return static_cast<double>(f) > x && std::isfinite(f) ? nextDown(f) : f;
+  return floatStep(f, static_cast<double>(f) > x && std::abs(f) <= kFloatMax, false);
 }
 inline float floatAbove(double x) {
   const auto f = static_cast<float>(x);
-  return static_cast<double>(f) < x && std::isfinite(f) ? nextUp(f) : f;
+  return floatStep(f, static_cast<double>(f) < x && std::abs(f) <= kFloatMax, true);
+}
+
+// The low two doubles of a and the low one of b as floats in lanes 0, 1, 2 (lane 3: b's high lane),
+// rounded to nearest as static_cast<float> rounds.
+inline __m128 toFloat3(__m128d xy, __m128d z) {
+  return _mm_movelh_ps(_mm_cvtpd_ps(xy), _mm_cvtpd_ps(z));
+}
+
+// floatBelow and floatAbove of three doubles at once (lanes 0–2; lane 3 unused), without branches.
+inline void floatBracket(__m128d xy, __m128d z, __m128& below, __m128& above) {
+  const __m128 f = toFloat3(xy, z);
+  const __m128d backXY = _mm_cvtps_pd(f);
+  const __m128d backZ = _mm_cvtps_pd(_mm_movehl_ps(f, f));
+  // 64-bit compare masks narrowed to 32-bit lanes 0–2.
+  const __m128 above64 =
+      _mm_shuffle_ps(_mm_castpd_ps(_mm_cmpgt_pd(backXY, xy)), _mm_castpd_ps(_mm_cmpgt_sd(backZ, z)),
+                     _MM_SHUFFLE(2, 0, 2, 0));
+  const __m128 below64 =
+      _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(backXY, xy)), _mm_castpd_ps(_mm_cmplt_sd(backZ, z)),
+                     _MM_SHUFFLE(2, 0, 2, 0));
+  const __m128 finite = _mm_cmple_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), f), _mm_set1_ps(kFloatMax));
+  const __m128i bits = _mm_castps_si128(f);
+  const __m128i twiceSign = _mm_add_epi32(_mm_srai_epi32(bits, 31), _mm_srai_epi32(bits, 31));
+  const __m128i up =
+      _mm_sub_epi32(_mm_set1_epi32(1), _mm_sub_epi32(_mm_setzero_si128(), twiceSign));
+  const __m128i down = _mm_sub_epi32(_mm_setzero_si128(), up);
+  // f above x: below steps toward −inf; f below x: above steps toward +inf.
+  below = _mm_castsi128_ps(
+      _mm_add_epi32(bits, _mm_and_si128(down, _mm_castps_si128(_mm_and_ps(above64, finite)))));
+  above = _mm_castsi128_ps(
+      _mm_add_epi32(bits, _mm_and_si128(up, _mm_castps_si128(_mm_and_ps(below64, finite)))));
+}
+
+template <int kLane>
+inline __m128 broadcast(__m128 v) {
+  return _mm_shuffle_ps(v, v, _MM_SHUFFLE(kLane, kLane, kLane, kLane));
 }
 
 // What the SSE slab tests of one traversal share. For a positive direction component the near
 // plane is the low one and the origin is rounded up there (down at the far plane), and the other
 // way round for a negative one, so the computed interval can only grow. A zero component gives
 // ±inf reciprocals, and the NaN of 0·inf (origin on the slab plane) is ignored by the min/max order
-// below, which keeps the test conservative.
+// below, which keeps the test conservative. Set up without branches: with random directions a
+// branch on a sign or a rounding direction mispredicts half the time.
 struct BoxRay {
   __m128 nearOrigin[3];
   __m128 farOrigin[3];
@@ -65,17 +114,39 @@ struct BoxRay {
   std::array<std::size_t, 3> farRow;
 
   explicit BoxRay(const Ray& ray) {
-    for (int axis = 0; axis < 3; ++axis) {
-      const double inverse = 1.0 / ray.direction[axis];
-      const double o = ray.origin[axis];
-      const bool negative = std::signbit(inverse);
-      nearInverse[axis] = _mm_set1_ps(static_cast<float>(inverse));
-      farInverse[axis] = _mm_set1_ps(static_cast<float>(inverse * kFarScale));
-      nearOrigin[axis] = _mm_set1_ps(negative ? floatBelow(o) : floatAbove(o));
-      farOrigin[axis] = _mm_set1_ps(negative ? floatAbove(o) : floatBelow(o));
-      constexpr std::size_t kRow = sizeof(Node::bounds[0]);
-      nearRow[axis] = kRow * static_cast<std::size_t>(negative ? axis + 3 : axis);
-      farRow[axis] = kRow * static_cast<std::size_t>(negative ? axis : axis + 3);
+    static_assert(std::is_standard_layout_v<Vec3> && sizeof(Vec3) == 3 * sizeof(double));
+    static_assert(std::is_standard_layout_v<Point3> && sizeof(Point3) == 3 * sizeof(double));
+    const __m128d one = _mm_set1_pd(1.0);
+    const __m128d scale = _mm_set1_pd(kFarScale);
+    const __m128d inverseXY = _mm_div_pd(one, _mm_loadu_pd(&ray.direction.x));
+    const __m128d inverseZ = _mm_div_sd(one, _mm_load_sd(&ray.direction.z));
+    const __m128 nearInv = toFloat3(inverseXY, inverseZ);
+    const __m128 farInv = toFloat3(_mm_mul_pd(inverseXY, scale), _mm_mul_sd(inverseZ, scale));
+    __m128 below;
+    __m128 above;
+    floatBracket(_mm_loadu_pd(&ray.origin.x), _mm_load_sd(&ray.origin.z), below, above);
+    // The sign of the double reciprocal, which its float rounding keeps.
+    const __m128 negative = _mm_castsi128_ps(_mm_srai_epi32(_mm_castps_si128(nearInv), 31));
+    const __m128 nearO = _mm_or_ps(_mm_and_ps(negative, below), _mm_andnot_ps(negative, above));
+    const __m128 farO = _mm_or_ps(_mm_and_ps(negative, above), _mm_andnot_ps(negative, below));
+    nearOrigin[0] = broadcast<0>(nearO);
+    nearOrigin[1] = broadcast<1>(nearO);
+    nearOrigin[2] = broadcast<2>(nearO);
+    farOrigin[0] = broadcast<0>(farO);
+    farOrigin[1] = broadcast<1>(farO);
+    farOrigin[2] = broadcast<2>(farO);
+    nearInverse[0] = broadcast<0>(nearInv);
+    nearInverse[1] = broadcast<1>(nearInv);
+    nearInverse[2] = broadcast<2>(nearInv);
+    farInverse[0] = broadcast<0>(farInv);
+    farInverse[1] = broadcast<1>(farInv);
+    farInverse[2] = broadcast<2>(farInv);
+    const auto signs = static_cast<unsigned>(_mm_movemask_ps(negative));
+    constexpr std::size_t kRow = sizeof(Node::bounds[0]);
+    for (unsigned axis = 0; axis < 3; ++axis) {
+      const std::size_t flip = 3 * ((signs >> axis) & 1u);
+      nearRow[axis] = kRow * (axis + flip);
+      farRow[axis] = kRow * (axis + 3 - flip);
     }
   }
 };
