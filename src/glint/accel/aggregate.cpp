@@ -43,25 +43,30 @@ constexpr std::size_t kTriangleChunk = 4096;
 constexpr double kFarScale = 1 + 0x1p-20;
 
 // The float nearest to x on the side toward −inf (floatBelow) or +inf (floatAbove); infinite beyond
-// the float range. Branch-free (the rounding direction of x to float is a coin toss per ray, so a
-// branch there mispredicts half the time): a one-ulp step is ±1 on the bit pattern, away from zero
-// on the side of x's sign (nextUp/nextDown of core/ulp.h; −0 steps to −denorm_min, +0 to
-// +denorm_min, exactly as they do).
-inline float floatStep(float f, bool step, bool up) {
-  const auto bits = std::bit_cast<std::uint32_t>(f);
-  const std::uint32_t negative = bits >> 31;
-  // Toward +inf: +1 for a positive pattern, −1 for a negative one; toward −inf the opposite.
-  const std::uint32_t delta = (up ? 1u : 0xffffffffu) * (1u - 2u * negative);
-  return std::bit_cast<float>(bits + (step ? delta : 0u));
+// the float range. Without branches (whether x rounds up or down to float is a coin toss per ray,
+// so a branch there mispredicts half the time): a one-ulp step is ±1 on the bit pattern, away from
+// zero on the side of the float's sign (nextUp/nextDown of core/ulp.h; −0 steps to −denorm_min and
+// +0 to +denorm_min, as they do). The comparisons are SSE masks, which the compiler cannot turn
+// back into branches.
+template <bool kUp>
+inline float floatStep(double x) {
+  const __m128d xd = _mm_set_sd(x);
+  const __m128 f = _mm_cvtsd_ss(_mm_setzero_ps(), xd);
+  const __m128d back = _mm_cvtss_sd(_mm_setzero_pd(), f);
+  // x above (kUp) or below the float: lane 0 all ones.
+  const __m128 off = _mm_castpd_ps(kUp ? _mm_cmplt_sd(back, xd) : _mm_cmpgt_sd(back, xd));
+  const __m128 finite = _mm_cmple_ss(_mm_andnot_ps(_mm_set1_ps(-0.0f), f), _mm_set1_ps(kFloatMax));
+  const __m128i bits = _mm_castps_si128(f);
+  const __m128i twiceSign = _mm_add_epi32(_mm_srai_epi32(bits, 31), _mm_srai_epi32(bits, 31));
+  // Toward +inf: +1 for a positive pattern, −1 for a negative one (1 + 2·sign, sign 0 or −1).
+  const __m128i up =
+      _mm_sub_epi32(_mm_set1_epi32(1), _mm_sub_epi32(_mm_setzero_si128(), twiceSign));
+  const __m128i delta = kUp ? up : _mm_sub_epi32(_mm_setzero_si128(), up);
+  const __m128i step = _mm_and_si128(delta, _mm_castps_si128(_mm_and_ps(off, finite)));
+  return _mm_cvtss_f32(_mm_castsi128_ps(_mm_add_epi32(bits, step)));
 }
-inline float floatBelow(double x) {
-  const auto f = static_cast<float>(x);
-  return floatStep(f, static_cast<double>(f) > x && std::abs(f) <= kFloatMax, false);
-}
-inline float floatAbove(double x) {
-  const auto f = static_cast<float>(x);
-  return floatStep(f, static_cast<double>(f) < x && std::abs(f) <= kFloatMax, true);
-}
+inline float floatBelow(double x) { return floatStep<false>(x); }
+inline float floatAbove(double x) { return floatStep<true>(x); }
 
 // The low two doubles of a and the low one of b as floats in lanes 0, 1, 2 (lane 3: b's high lane),
 // rounded to nearest as static_cast<float> rounds.
