@@ -104,6 +104,25 @@ inline __m128 broadcast(__m128 v) {
   return _mm_shuffle_ps(v, v, _MM_SHUFFLE(kLane, kLane, kLane, kLane));
 }
 
+// Byte offsets of the rows of Node::bounds (0–2 low, 3–5 high) a slab test reads per axis, for each
+// octant of the direction (bit a set: component a negative, the near plane is the high one).
+struct SlabRows {
+  std::array<std::size_t, 3> nearRow;
+  std::array<std::size_t, 3> farRow;
+};
+constexpr std::array<SlabRows, 8> kSlabRows = [] {
+  std::array<SlabRows, 8> table{};
+  constexpr std::size_t kRow = sizeof(Node::bounds[0]);
+  for (std::size_t signs = 0; signs < 8; ++signs) {
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+      const std::size_t flip = 3 * ((signs >> axis) & 1u);
+      table[signs].nearRow[axis] = kRow * (axis + flip);
+      table[signs].farRow[axis] = kRow * (axis + 3 - flip);
+    }
+  }
+  return table;
+}();
+
 // What the SSE slab tests of one traversal share. For a positive direction component the near
 // plane is the low one and the origin is rounded up there (down at the far plane), and the other
 // way round for a negative one, so the computed interval can only grow. A zero component gives
@@ -115,8 +134,7 @@ struct BoxRay {
   __m128 farOrigin[3];
   __m128 nearInverse[3];
   __m128 farInverse[3];
-  std::array<std::size_t, 3> nearRow;  // byte offsets of rows of Node::bounds: 0–2 low, 3–5 high
-  std::array<std::size_t, 3> farRow;
+  SlabRows rows;
 
   explicit BoxRay(const Ray& ray) {
     static_assert(std::is_standard_layout_v<Vec3> && sizeof(Vec3) == 3 * sizeof(double));
@@ -146,13 +164,7 @@ struct BoxRay {
     farInverse[0] = broadcast<0>(farInv);
     farInverse[1] = broadcast<1>(farInv);
     farInverse[2] = broadcast<2>(farInv);
-    const auto signs = static_cast<unsigned>(_mm_movemask_ps(negative));
-    constexpr std::size_t kRow = sizeof(Node::bounds[0]);
-    for (unsigned axis = 0; axis < 3; ++axis) {
-      const std::size_t flip = 3 * ((signs >> axis) & 1u);
-      nearRow[axis] = kRow * (axis + flip);
-      farRow[axis] = kRow * (axis + 3 - flip);
-    }
+    rows = kSlabRows[static_cast<unsigned>(_mm_movemask_ps(negative)) & 7u];
   }
 };
 
@@ -165,14 +177,14 @@ inline int intersectNode(const Node& node, const BoxRay& r, __m128 tMin, __m128 
   __m128 tf = tMax;
   const auto* base = reinterpret_cast<const unsigned char*>(node.bounds);
   for (int axis = 0; axis < 3; ++axis) {
-    const __m128 n =
-        _mm_mul_ps(_mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + r.nearRow[axis])),
-                              r.nearOrigin[axis]),
-                   r.nearInverse[axis]);
-    const __m128 f =
-        _mm_mul_ps(_mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + r.farRow[axis])),
-                              r.farOrigin[axis]),
-                   r.farInverse[axis]);
+    const __m128 n = _mm_mul_ps(
+        _mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + r.rows.nearRow[axis])),
+                   r.nearOrigin[axis]),
+        r.nearInverse[axis]);
+    const __m128 f = _mm_mul_ps(
+        _mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + r.rows.farRow[axis])),
+                   r.farOrigin[axis]),
+        r.farInverse[axis]);
     tn = _mm_max_ps(n, tn);
     tf = _mm_min_ps(f, tf);
   }
