@@ -68,7 +68,7 @@ inline float floatStep(double x) {
 inline float floatBelow(double x) { return floatStep<false>(x); }
 inline float floatAbove(double x) { return floatStep<true>(x); }
 
-// The low two doubles of a and the low one of b as floats in lanes 0, 1, 2 (lane 3: b's high lane),
+// The two doubles of xy and the low one of z as floats in lanes 0, 1, 2 (lane 3: z's high lane),
 // rounded to nearest as static_cast<float> rounds.
 inline __m128 toFloat3(__m128d xy, __m128d z) {
   return _mm_movelh_ps(_mm_cvtpd_ps(xy), _mm_cvtpd_ps(z));
