@@ -70,6 +70,13 @@ inline double coordinate(const Point3& p, int axis) {
               sizeof value);
   return value;
 }
+inline double coordinate(const Vec3& v, int axis) {
+  static_assert(std::is_standard_layout_v<Vec3> && sizeof(Vec3) == 3 * sizeof(double));
+  double value;
+  std::memcpy(&value, reinterpret_cast<const unsigned char*>(&v) + axis * sizeof(double),
+              sizeof value);
+  return value;
+}
 
 }  // namespace watertight_detail
 
@@ -82,16 +89,26 @@ struct WatertightRay {
   double sx = 0, sy = 0, sz = 1;
 
   WatertightRay() = default;  // for callers that set it up lazily
+  // Set up without branches (with random directions a branch on the axis order mispredicts
+  // often); the same values as the textbook form.
   explicit WatertightRay(const Ray& ray) : origin(ray.origin) {
+    using watertight_detail::coordinate;
     const Vec3& d = ray.direction;
-    const Vec3 absD = abs(d);
-    kz = (absD.x > absD.y) ? (absD.x > absD.z ? 0 : 2) : (absD.y > absD.z ? 1 : 2);
-    kx = (kz + 1) % 3;
-    ky = (kx + 1) % 3;
-    if (d[kz] < 0) std::swap(kx, ky);
-    sx = d[kx] / d[kz];
-    sy = d[ky] / d[kz];
-    sz = 1.0 / d[kz];
+    const double absX = std::abs(d.x);
+    const double absY = std::abs(d.y);
+    const double absZ = std::abs(d.z);
+    const int zIfX = absX > absZ ? 0 : 2;
+    const int zIfY = absY > absZ ? 1 : 2;
+    kz = absX > absY ? zIfX : zIfY;
+    const double dz = coordinate(d, kz);
+    const int next = kz == 2 ? 0 : kz + 1;
+    const int afterNext = next == 2 ? 0 : next + 1;
+    const bool flip = dz < 0;  // swap x and y to keep the winding
+    kx = flip ? afterNext : next;
+    ky = flip ? next : afterNext;
+    sx = coordinate(d, kx) / dz;
+    sy = coordinate(d, ky) / dz;
+    sz = 1.0 / dz;
   }
 };
 
