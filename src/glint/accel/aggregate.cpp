@@ -192,23 +192,6 @@ inline int intersectNode(const Node& node, const BoxRay& r, __m128 tMin, __m128 
   return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
 }
 
-// Starts loading a child the traversal is about to visit: both cache lines of an inner node; the
-// primitive references or the triangles' index triples of a leaf.
-inline void prefetchChild(const Node* nodes, const std::uint32_t* refs,
-                          const std::vector<TriangleMesh>& meshes, std::uint32_t child,
-                          std::uint32_t info) {
-  if (info == kInner) {
-    const char* p = reinterpret_cast<const char*>(nodes + child);
-    _mm_prefetch(p, _MM_HINT_T0);
-    _mm_prefetch(p + 64, _MM_HINT_T0);
-  } else if (const std::uint32_t key = bvh::leafKey(info); key == kPrimitiveKey) {
-    _mm_prefetch(reinterpret_cast<const char*>(refs + child), _MM_HINT_T0);
-  } else {
-    _mm_prefetch(reinterpret_cast<const char*>(meshes[key].indices.data() + 3 * std::size_t{child}),
-                 _MM_HINT_T0);
-  }
-}
-
 struct StackEntry {
   std::uint32_t child;
   std::uint32_t info;
@@ -554,10 +537,6 @@ bool Aggregate::intersect(const Ray& ray, double tMin, double tMax, Hit& hit) co
         if (mask != 0) {
           alignas(16) std::array<float, 4> tNear;
           _mm_store_ps(tNear.data(), tNearV);
-          for (int bits = mask; bits != 0; bits &= bits - 1) {
-            const int i = std::countr_zero(static_cast<unsigned>(bits));
-            prefetchChild(nodes_.data(), leafRefs_.data(), meshes_, node.child[i], node.info[i]);
-          }
           const int first = std::countr_zero(static_cast<unsigned>(mask));
           mask &= mask - 1;
           if (mask == 0) {
