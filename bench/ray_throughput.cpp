@@ -2,7 +2,7 @@
 // (issue 4, bench 1): Mrays/s per scene × ray set × query × thread count, the ratio glint/Embree,
 // the 2-thread speedups, and both BVH build times.
 //
-//   ray_throughput [--runs N] [--quick] [--no-packets]
+//   ray_throughput [--runs N] [--quick] [--no-packets] [--embree-isa ISA]
 //
 // Scenes: a 100k- and a 1M-triangle torus over a two-triangle floor, and 1000 spheres (glint:
 // analytic spheres; Embree: RTC_GEOMETRY_TYPE_SPHERE_POINT, a true ray–sphere intersection) over
@@ -145,16 +145,18 @@ void printRow(const Row& r, bool packets) {
 
 int run(int argc, char** argv) {
   const std::string usage =
-      "usage: ray_throughput [--runs N] [--quick] [--no-packets]\n"
+      "usage: ray_throughput [--runs N] [--quick] [--no-packets] [--embree-isa ISA]\n"
       "  --runs N      repetitions per figure (median printed; default 5)\n"
       "  --quick       10k-triangle torus instead of 1M, 256x192 rays (smoke test)\n"
-      "  --no-packets  skip the informative Embree 16-ray packet column\n";
-  std::vector<ExtraOption> extra{{"--no-packets", false}};
+      "  --no-packets  skip the informative Embree 16-ray packet column\n"
+      "  --embree-isa ISA  run Embree's kernels for ISA (sse2, sse4.2, avx, avx2, avx512) instead\n"
+      "                of the widest this CPU has: glint's own build targets baseline x86-64\n";
+  std::vector<ExtraOption> extra{{"--no-packets", false}, {"--embree-isa", true}};
   const CommonOptions options = parseCommonOptions(argc, argv, usage, &extra);
   const bool packets = !extra[0].present;
   printHeader("ray throughput: glint vs Embree", options);
 
-  EmbreeDevice device;
+  EmbreeDevice device(extra[1].present ? "isa=" + extra[1].value : "");
   std::printf("%s; glint double precision, Embree single precision\n", device.describe().c_str());
 
   std::vector<BenchScene> scenes;
