@@ -1063,7 +1063,13 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
     };
     if (answer >= 0 && send(answer)) {
       writeValue(fds[1], 'D');
-    } else if (writeValue(fds[1], 'P')) {
+      ::_exit(0);
+    }
+    // A partly written memory file would hold its pages until the parent closes it, after the
+    // whole answer has come through the pipe as well: under the memory pressure that made the
+    // write fail, give them back first.
+    if (answer >= 0) static_cast<void>(::ftruncate(answer, 0));
+    if (writeValue(fds[1], 'P')) {
       send(fds[1]);
     }
     ::_exit(0);

@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <mutex>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <variant>
@@ -58,10 +59,12 @@ struct TraceContext {
   int maxDepth;
   double minWeight;
   std::uint32_t blurSamples;
-  // One Hit per path depth (maxDepth of them), owned by the caller: trace() at depth d fills
-  // hits[d], which stays valid while its child rays run. Reused rather than a fresh Hit per call,
-  // whose 120 bytes of default initialisation (rep stos) cost more than the rest of a miss.
+  // One Hit per path depth, owned by the caller: trace() at depth d < hitCount fills hits[d], which
+  // stays valid while its child rays run. Reused rather than a fresh Hit per call, whose 120 bytes
+  // of default initialisation (rep stos) cost more than the rest of a miss. Deeper paths (a scene
+  // built in code may set any maxDepth) use a Hit of their own frame.
   Hit* hits;
+  int hitCount;
 };
 
 enum class SecondaryKind { Reflection, Refraction };
@@ -272,7 +275,8 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
 Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split,
             const SampleStream& stream) {
   // Aggregate::intersect sets every field of a hit it reports; a miss reads nothing.
-  Hit& hit = ctx.hits[depth];
+  std::optional<Hit> deepHit;  // constructed only past the preallocated depths
+  Hit& hit = depth < ctx.hitCount ? ctx.hits[depth] : deepHit.emplace();
   if (!ctx.scene.intersect(ray, kInfinity, hit)) return ctx.scene.background();
   const int hitDepth = depth + 1;
 
@@ -338,9 +342,13 @@ Color traceCameraRay(const TraceContext& ctx, const Ray& ray, const SampleStream
   return trace(ctx, Ray{ray.origin, normalize(ray.direction)}, 0, Color(1), false, stream);
 }
 
-// The per-depth hits a TraceContext points into (one allocation per tile, not per ray).
+// The per-depth hits a TraceContext points into (one allocation per tile, not per ray): one per
+// depth a path can reach, at most kPreallocatedDepths (the default max_depth is 10; scene files
+// allow up to 1000, and a scene built in code any value).
+constexpr int kPreallocatedDepths = 64;
 std::vector<Hit> hitStorage(const Scene& scene) {
-  return std::vector<Hit>(static_cast<std::size_t>(std::max(scene.render().maxDepth, 1)));
+  return std::vector<Hit>(
+      static_cast<std::size_t>(std::clamp(scene.render().maxDepth, 1, kPreallocatedDepths)));
 }
 
 TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>& hits) {
@@ -350,7 +358,8 @@ TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>
                       settings.maxDepth,
                       settings.minWeight,
                       static_cast<std::uint32_t>(std::max(settings.blurSamples, 1)),
-                      hits.data()};
+                      hits.data(),
+                      static_cast<int>(hits.size())};
 }
 
 PixelRegion validatedRegion(const Scene& scene, const RenderOptions& options) {
