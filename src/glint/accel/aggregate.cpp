@@ -211,10 +211,18 @@ inline TriangleVertices verticesOf(const TriangleMesh& mesh, std::uint32_t trian
 }
 
 // The watertight test of geometry's Triangle on a mesh triangle, rejecting rays in its plane.
+// `normal` receives the unnormalised geometric normal (p1 − p0) × (p2 − p0) the plane test needs,
+// when the watertight test hits; the closest-hit query keeps it for finishTriangleHit.
+inline bool hitTriangle(const WatertightRay& wray, const Vec3& direction, const TriangleVertices& v,
+                        double tMin, double tMax, WatertightHit& candidate, Vec3& normal) {
+  if (!intersectWatertight(wray, v.p0, v.p1, v.p2, tMin, tMax, candidate)) return false;
+  normal = cross(v.p1 - v.p0, v.p2 - v.p0);
+  return !isParallelToPlane(normal, direction);
+}
 inline bool hitTriangle(const WatertightRay& wray, const Vec3& direction, const TriangleVertices& v,
                         double tMin, double tMax, WatertightHit& candidate) {
-  return intersectWatertight(wray, v.p0, v.p1, v.p2, tMin, tMax, candidate) &&
-         !isParallelToPlane(cross(v.p1 - v.p0, v.p2 - v.p0), direction);
+  Vec3 normal;
+  return hitTriangle(wray, direction, v, tMin, tMax, candidate, normal);
 }
 
 // The sign an edge function X.x·Y.y − X.y·Y.x that is exactly 0 takes when the ray's origin moves,
@@ -475,11 +483,12 @@ std::size_t Aggregate::memoryBytes() const {
 }
 
 void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
-                                  const WatertightHit& candidate, Hit& hit) const {
+                                  const WatertightHit& candidate, const Vec3& normal,
+                                  Hit& hit) const {
   const TriangleMesh& m = meshes_[mesh];
   const TriangleVertices v = verticesOf(m, triangle);
   hit.t = candidate.t;
-  hit.normal = Normal3(normalize(cross(v.p1 - v.p0, v.p2 - v.p0)));
+  hit.normal = Normal3(normalize(normal));
   hit.shadingNormal = hit.normal;
   watertightHitPoint(v.p0, v.p1, v.p2, candidate, hit.point, hit.pointError);
   hit.primitive = 0;
@@ -506,13 +515,18 @@ bool Aggregate::intersect(const Ray& ray, double tMin, double tMax, Hit& hit) co
   std::uint32_t hitIndex = 0;  // primitive, or triangle within hitMesh
   std::uint32_t hitMesh = 0;
   WatertightHit triangleHit;
+  Vec3 triangleNormal;  // of the closest triangle hit, unnormalised (see hitTriangle)
 
   // Unbounded primitives first: they are typically ground planes and walls, and a hit there shrinks
-  // the interval the BVH has to search.
+  // the interval the BVH has to search. A plane's hit point waits until it is known to be the
+  // closest hit: a third of the plane hits of the spheres scene lie behind a sphere.
+  bool primitiveHitComplete = true;
   for (const std::uint32_t index : unbounded_) {
-    if (primitives_[index].intersect(ray, tMin, closest, shapeHit)) {
+    bool complete;
+    if (primitives_[index].intersectDeferred(ray, tMin, closest, shapeHit, complete)) {
       closest = shapeHit.t;
       primitiveHit = shapeHit;
+      primitiveHitComplete = complete;
       hitIndex = index;
       found = Found::Primitive;
     }
@@ -574,6 +588,7 @@ bool Aggregate::intersect(const Ray& ray, double tMin, double tMax, Hit& hit) co
             if (primitives_[index].intersect(ray, tMin, closest, shapeHit)) {
               closest = shapeHit.t;
               primitiveHit = shapeHit;
+              primitiveHitComplete = true;
               hitIndex = index;
               found = Found::Primitive;
               closer = true;
@@ -586,10 +601,12 @@ bool Aggregate::intersect(const Ray& ray, double tMin, double tMax, Hit& hit) co
             wrayReady = true;
           }
           WatertightHit candidate;  // a rejected (parallel) candidate must not overwrite the best
+          Vec3 candidateNormal;
           for (std::uint32_t triangle = child; triangle < child + count; ++triangle) {
             if (hitTriangle(wray, ray.direction, verticesOf(mesh, triangle), tMin, closest,
-                            candidate)) {
+                            candidate, candidateNormal)) {
               triangleHit = candidate;
+              triangleNormal = candidateNormal;
               closest = candidate.t;
               hitIndex = triangle;
               hitMesh = key;
@@ -613,8 +630,9 @@ bool Aggregate::intersect(const Ray& ray, double tMin, double tMax, Hit& hit) co
   }
 
   if (found == Found::Triangle) {
-    finishTriangleHit(hitMesh, hitIndex, triangleHit, hit);
+    finishTriangleHit(hitMesh, hitIndex, triangleHit, triangleNormal, hit);
   } else if (found == Found::Primitive) {
+    if (!primitiveHitComplete) primitives_[hitIndex].completeHit(ray, primitiveHit);
     hit.t = closest;
     hit.normal = primitiveHit.normal;
     hit.shadingNormal = primitiveHit.normal;
@@ -732,20 +750,24 @@ bool Aggregate::intersectBruteForce(const Ray& ray, double tMin, double tMax, Hi
   std::uint32_t hitMesh = kNoMesh;
   std::uint32_t hitTriangleIndex = 0;
   WatertightHit best;
+  Vec3 candidateNormal;
+  Vec3 bestNormal;
   for (std::uint32_t m = 0; m < meshes_.size(); ++m) {
     const TriangleMesh& mesh = meshes_[m];
     for (std::uint32_t k = meshBegin_[m]; k < meshBegin_[m + 1]; ++k) {
       const std::uint32_t triangle = leafRefs_[k];
-      if (hitTriangle(wray, ray.direction, verticesOf(mesh, triangle), tMin, closest, candidate)) {
+      if (hitTriangle(wray, ray.direction, verticesOf(mesh, triangle), tMin, closest, candidate,
+                      candidateNormal)) {
         closest = candidate.t;
         best = candidate;
+        bestNormal = candidateNormal;
         hitMesh = m;
         hitTriangleIndex = triangle;
       }
     }
   }
   if (hitMesh == kNoMesh) return found;
-  finishTriangleHit(hitMesh, hitTriangleIndex, best, hit);
+  finishTriangleHit(hitMesh, hitTriangleIndex, best, bestNormal, hit);
   return true;
 }
 

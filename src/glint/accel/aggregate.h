@@ -74,8 +74,9 @@ class Aggregate {
  private:
   bool intersectBruteForce(const Ray& ray, double tMin, double tMax, Hit& hit) const;
   Color transmittanceBruteForce(const Ray& ray, double tMin, double tMax) const;
+  // normal: the triangle's unnormalised geometric normal (p1 − p0) × (p2 − p0).
   void finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle, const WatertightHit& candidate,
-                         Hit& hit) const;
+                         const Vec3& normal, Hit& hit) const;
   void storeInLeafOrder(const std::vector<bvh::BuildItem>& items);
   friend struct AggregateInspector;  // aggregate_test.cpp checks the node layout invariants
 

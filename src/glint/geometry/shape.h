@@ -185,6 +185,13 @@ class Primitive {
 
   // World-space closest hit; the normal is transformed to world space and normalised.
   bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  // intersect in two steps, for a caller that may yet find a closer hit elsewhere: on a hit,
+  // `complete` says whether hit is whole; when false only hit.t is set (an untransformed plane,
+  // whose hit point is most of its cost), and completeHit(ray, hit) fills the rest, exactly as
+  // intersect would have.
+  bool intersectDeferred(const Ray& ray, double tMin, double tMax, ShapeHit& hit,
+                         bool& complete) const;
+  void completeHit(const Ray& ray, ShapeHit& hit) const;
   int crossings(const Ray& ray, double tMin, double tMax) const;
   Bounds3 bounds() const { return bounds_; }
   bool isBounded() const { return bounds_.isBounded(); }

@@ -363,13 +363,19 @@ namespace {
   return inOpenRange(t, tMin, tMax);
 }
 
+// The rest of a plane hit whose t is set.
+[[gnu::always_inline]] inline void planeCompleteHit(const Plane& plane, const Ray& ray,
+                                                    ShapeHit& hit) {
+  hit.normal = plane.normal;
+  planeHitPoint(ray, hit.t, plane.point, plane.normal, 0, hit);
+}
+
 [[gnu::always_inline]] inline bool planeIntersect(const Plane& plane, const Ray& ray, double tMin,
                                                   double tMax, ShapeHit& hit) {
   double t;
   if (!planeCrossing(plane.point, plane.normal, ray, tMin, tMax, t)) return false;
   hit.t = t;
-  hit.normal = plane.normal;
-  planeHitPoint(ray, t, plane.point, plane.normal, 0, hit);
+  planeCompleteHit(plane, ray, hit);
   return true;
 }
 
@@ -986,6 +992,21 @@ bool Primitive::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hi
   hit.point = (*worldFromObject_)(objectPoint);
   hit.pointError = worldPointError(*worldFromObject_, objectPoint, hit.pointError, hit.point);
   return true;
+}
+
+bool Primitive::intersectDeferred(const Ray& ray, double tMin, double tMax, ShapeHit& hit,
+                                  bool& complete) const {
+  if (const auto* plane = std::get_if<Plane>(&shape_); plane && !worldFromObject_) {
+    complete = false;
+    return planeCrossing(plane->point, plane->normal, ray, tMin, tMax, hit.t);
+  }
+  complete = true;
+  return intersect(ray, tMin, tMax, hit);
+}
+
+void Primitive::completeHit(const Ray& ray, ShapeHit& hit) const {
+  // Only an untransformed plane defers (intersectDeferred).
+  planeCompleteHit(std::get<Plane>(shape_), ray, hit);
 }
 
 int Primitive::crossings(const Ray& ray, double tMin, double tMax) const {

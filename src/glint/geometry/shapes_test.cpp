@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -1188,6 +1189,36 @@ TEST(ShapePrimitive, WithoutTransformMatchesTheShape) {
   EXPECT_TRUE(std::holds_alternative<Sphere>(prim.shape()));
   EXPECT_TRUE(prim.isBounded());
   EXPECT_FALSE(Primitive(Plane::make({0, 0, 0}, {0, 1, 0}), 0, Color()).isBounded());
+}
+
+// intersectDeferred followed by completeHit (when it defers) gives intersect's hit bit for bit:
+// untransformed planes defer their hit point, every other primitive answers whole.
+TEST(ShapePrimitive, DeferredHitEqualsIntersectBitForBit) {
+  const std::vector<Primitive> prims = {
+      Primitive(Plane::make({0.3, -1, 0.2}, {0.1, 1, -0.3}), 0, Color()),
+      Primitive(Plane::make({0, 0, 0}, {0, 1, 0}), 0, Color(), Transform::translate({0, -1, 0})),
+      Primitive(Sphere::make({0.5, 0, -3}, 1.5), 0, Color())};
+  const bool defers[] = {true, false, false};
+  Rng rng(11);
+  int hits = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Ray ray{{4 * rng.uniform() - 2, 4 * rng.uniform() - 2, 4 * rng.uniform() - 2},
+                  {2 * rng.uniform() - 1, 2 * rng.uniform() - 1, 2 * rng.uniform() - 1}};
+    const double tMax = i % 2 == 0 ? kInfinity : 3 * rng.uniform();
+    for (std::size_t k = 0; k < prims.size(); ++k) {
+      ShapeHit whole;
+      ShapeHit deferred;
+      bool complete = false;
+      const bool hit = prims[k].intersect(ray, 1e-9, tMax, whole);
+      ASSERT_EQ(prims[k].intersectDeferred(ray, 1e-9, tMax, deferred, complete), hit);
+      if (!hit) continue;
+      ++hits;
+      EXPECT_EQ(complete, !defers[k]);
+      if (!complete) prims[k].completeHit(ray, deferred);
+      EXPECT_EQ(std::memcmp(&whole, &deferred, sizeof(ShapeHit)), 0) << "primitive " << k;
+    }
+  }
+  EXPECT_GT(hits, 1000);
 }
 
 TEST(ShapePrimitive, TranslatedSphere) {
