@@ -42,6 +42,21 @@ constexpr std::size_t kTriangleChunk = 4096;
 // absolute, not relative, so it is not padded but rounded toward the safe side per slab plane.
 constexpr double kFarScale = 1 + 0x1p-20;
 
+// The floats of f one ulp further toward +inf (kUp) or −inf in the lanes where `where` is all ones
+// and f is finite; the other lanes unchanged.
+template <bool kUp>
+inline __m128 stepWhere(__m128 f, __m128 where) {
+  const __m128 finite = _mm_cmple_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), f), _mm_set1_ps(kFloatMax));
+  const __m128i bits = _mm_castps_si128(f);
+  const __m128i twiceSign = _mm_add_epi32(_mm_srai_epi32(bits, 31), _mm_srai_epi32(bits, 31));
+  // Toward +inf: +1 for a positive pattern, −1 for a negative one (1 + 2·sign, sign 0 or −1).
+  const __m128i up =
+      _mm_sub_epi32(_mm_set1_epi32(1), _mm_sub_epi32(_mm_setzero_si128(), twiceSign));
+  const __m128i delta = kUp ? up : _mm_sub_epi32(_mm_setzero_si128(), up);
+  const __m128i step = _mm_and_si128(delta, _mm_castps_si128(_mm_and_ps(where, finite)));
+  return _mm_castsi128_ps(_mm_add_epi32(bits, step));
+}
+
 // The float nearest to x on the side toward −inf (floatBelow) or +inf (floatAbove); infinite beyond
 // the float range. Without branches (whether x rounds up or down to float is a coin toss per ray,
 // so a branch there mispredicts half the time): a one-ulp step is ±1 on the bit pattern, away from
@@ -55,15 +70,7 @@ inline float floatStep(double x) {
   const __m128d back = _mm_cvtss_sd(_mm_setzero_pd(), f);
   // x above (kUp) or below the float: lane 0 all ones.
   const __m128 off = _mm_castpd_ps(kUp ? _mm_cmplt_sd(back, xd) : _mm_cmpgt_sd(back, xd));
-  const __m128 finite = _mm_cmple_ss(_mm_andnot_ps(_mm_set1_ps(-0.0f), f), _mm_set1_ps(kFloatMax));
-  const __m128i bits = _mm_castps_si128(f);
-  const __m128i twiceSign = _mm_add_epi32(_mm_srai_epi32(bits, 31), _mm_srai_epi32(bits, 31));
-  // Toward +inf: +1 for a positive pattern, −1 for a negative one (1 + 2·sign, sign 0 or −1).
-  const __m128i up =
-      _mm_sub_epi32(_mm_set1_epi32(1), _mm_sub_epi32(_mm_setzero_si128(), twiceSign));
-  const __m128i delta = kUp ? up : _mm_sub_epi32(_mm_setzero_si128(), up);
-  const __m128i step = _mm_and_si128(delta, _mm_castps_si128(_mm_and_ps(off, finite)));
-  return _mm_cvtss_f32(_mm_castsi128_ps(_mm_add_epi32(bits, step)));
+  return _mm_cvtss_f32(stepWhere<kUp>(f, off));
 }
 inline float floatBelow(double x) { return floatStep<false>(x); }
 inline float floatAbove(double x) { return floatStep<true>(x); }
@@ -86,17 +93,9 @@ inline void floatBracket(__m128d xy, __m128d z, __m128& below, __m128& above) {
   const __m128 below64 =
       _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(backXY, xy)), _mm_castpd_ps(_mm_cmplt_sd(backZ, z)),
                      _MM_SHUFFLE(2, 0, 2, 0));
-  const __m128 finite = _mm_cmple_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), f), _mm_set1_ps(kFloatMax));
-  const __m128i bits = _mm_castps_si128(f);
-  const __m128i twiceSign = _mm_add_epi32(_mm_srai_epi32(bits, 31), _mm_srai_epi32(bits, 31));
-  const __m128i up =
-      _mm_sub_epi32(_mm_set1_epi32(1), _mm_sub_epi32(_mm_setzero_si128(), twiceSign));
-  const __m128i down = _mm_sub_epi32(_mm_setzero_si128(), up);
   // f above x: below steps toward −inf; f below x: above steps toward +inf.
-  below = _mm_castsi128_ps(
-      _mm_add_epi32(bits, _mm_and_si128(down, _mm_castps_si128(_mm_and_ps(above64, finite)))));
-  above = _mm_castsi128_ps(
-      _mm_add_epi32(bits, _mm_and_si128(up, _mm_castps_si128(_mm_and_ps(below64, finite)))));
+  below = stepWhere<false>(f, above64);
+  above = stepWhere<true>(f, below64);
 }
 
 template <int kLane>

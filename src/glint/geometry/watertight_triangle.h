@@ -61,19 +61,14 @@ inline double edgeFunction(double a, double b, double c, double d) {
 #endif
 }
 
-// Coordinate `axis` of a point (0 = x, 1 = y, 2 = z) read from its object representation: one load
-// with a computed offset, where Point3::operator[] would branch.
-inline double coordinate(const Point3& p, int axis) {
-  static_assert(std::is_standard_layout_v<Point3> && sizeof(Point3) == 3 * sizeof(double));
+// Coordinate `axis` (0 = x, 1 = y, 2 = z) of a Point3 or Vec3 read from its object representation:
+// one load with a computed offset, where operator[] would branch.
+template <typename Triple>
+requires std::is_same_v<Triple, Point3> || std::is_same_v<Triple, Vec3>
+inline double coordinate(const Triple& p, int axis) {
+  static_assert(std::is_standard_layout_v<Triple> && sizeof(Triple) == 3 * sizeof(double));
   double value;
   std::memcpy(&value, reinterpret_cast<const unsigned char*>(&p) + axis * sizeof(double),
-              sizeof value);
-  return value;
-}
-inline double coordinate(const Vec3& v, int axis) {
-  static_assert(std::is_standard_layout_v<Vec3> && sizeof(Vec3) == 3 * sizeof(double));
-  double value;
-  std::memcpy(&value, reinterpret_cast<const unsigned char*>(&v) + axis * sizeof(double),
               sizeof value);
   return value;
 }
