@@ -273,36 +273,33 @@ SceneParts facingMirrors(const Material& mirror) {
   return parts;
 }
 
-TEST(Renderer, PrimaryHitIsDepthOne) {
+// The ray counts of one path started between facingMirrors of reflectivity 0.5.
+RayCounts mirrorPathCounts(int maxDepth, double minWeight) {
   Material mirror;
   mirror.kr = Color(0.5);
+  SceneParts parts = facingMirrors(mirror);
+  parts.render.maxDepth = maxDepth;
+  parts.render.minWeight = minWeight;
+  const Scene scene(std::move(parts));
+  RayCounts counts;
+  Rng rng(1);
+  traceRay(scene, Ray{{0, 0, 0}, {0, 0, -1}}, rng, &counts);
+  return counts;
+}
+
+TEST(Renderer, PrimaryHitIsDepthOne) {
+  // 70: past the 64 depths the renderer keeps a Hit for in advance.
   for (const int maxDepth : {1, 2, 4, 70}) {
-    SceneParts parts = facingMirrors(mirror);
-    parts.render.maxDepth = maxDepth;
-    parts.render.minWeight = 0;
-    const Scene scene(std::move(parts));
-    RayCounts counts;
-    Rng rng(1);
-    traceRay(scene, Ray{{0, 0, 0}, {0, 0, -1}}, rng, &counts);
+    const RayCounts counts = mirrorPathCounts(maxDepth, 0);
     EXPECT_EQ(counts.camera, 1u);
     EXPECT_EQ(counts.reflection, static_cast<std::uint64_t>(maxDepth - 1));
   }
 }
 
-// The renderer keeps one Hit per depth for up to 64 depths (PrimaryHitIsDepthOne goes past them);
-// a scene built in code may ask for any depth, and nothing is allocated per possible depth.
+// A scene built in code may ask for any depth; nothing is allocated per possible depth, and
+// min_weight ends the path: a tenth reflection would weigh 0.5^10 < 0.001.
 TEST(Renderer, UnlimitedDepthEndsByWeight) {
-  Material mirror;
-  // min_weight ends the path: a tenth reflection would weigh 0.5^10 < 0.001.
-  mirror.kr = Color(0.5);
-  SceneParts parts = facingMirrors(mirror);
-  parts.render.maxDepth = std::numeric_limits<int>::max();
-  parts.render.minWeight = 0.001;
-  const Scene scene(std::move(parts));
-  RayCounts counts;
-  Rng rng(1);
-  traceRay(scene, Ray{{0, 0, 0}, {0, 0, -1}}, rng, &counts);
-  EXPECT_EQ(counts.reflection, 9u);
+  EXPECT_EQ(mirrorPathCounts(std::numeric_limits<int>::max(), 0.001).reflection, 9u);
 }
 
 TEST(Renderer, GlossySplitsOnceThenUsesOneRayPerBounce) {
