@@ -37,13 +37,17 @@ constexpr double gammaBound(int n) {
   return n * u / (1 - n * u);
 }
 
+// The side of the surface a ray leaving in direction w starts on: the side n points to when
+// n·w ≥ 0. offsetRayOrigin depends on w only through this.
+inline bool leavesAlongNormal(const Normal3& n, const Vec3& w) { return dot(n, w) >= 0; }
+
 // Moves the hit point p (per-coordinate error bound pError) off its surface along the geometric
 // unit normal n, to the side the direction w leaves toward (the +n side when w is tangent).
 inline Point3 offsetRayOrigin(const Point3& p, const Vec3& pError, const Normal3& n,
                               const Vec3& w) {
   const double d =
       2 * (std::abs(n.x) * pError.x + std::abs(n.y) * pError.y + std::abs(n.z) * pError.z);
-  const double side = dot(n, w) >= 0 ? 1.0 : -1.0;
+  const double side = leavesAlongNormal(n, w) ? 1.0 : -1.0;
   const Vec3 along = toVec(n) * side;
   Point3 o = p + along * d;
   // One ulp further away from the surface on every axis the normal has a component along: covers

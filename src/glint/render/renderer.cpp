@@ -96,7 +96,7 @@ class SpawnOrigins {
 
   // The ray spawnRay(p, pError, n, w) returns.
   Ray spawn(const Vec3& w) {
-    const int side = dot(n_, w) >= 0 ? 1 : 0;  // offsetRayOrigin's test
+    const int side = leavesAlongNormal(n_, w) ? 1 : 0;
     if (!ready_[side]) {
       origin_[side] = offsetRayOrigin(p_, pError_, n_, w);
       ready_[side] = true;

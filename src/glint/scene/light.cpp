@@ -11,21 +11,8 @@
 
 namespace glint {
 
-namespace {
-
 using light_detail::attenuate;
-
-// l and d from a positional light to p; false when p is the light's position (l undefined).
-bool towardPoint(const Point3& lightPosition, const Point3& p, LightSample& sample) {
-  const Vec3 offset = p - lightPosition;
-  const double d = length(offset);
-  if (!(d > 0)) return false;
-  sample.toPoint = offset / d;
-  sample.distance = d;
-  return true;
-}
-
-}  // namespace
+using light_detail::towardPoint;
 
 LightSample illuminate(const Light& light, const Point3& p) {
   return std::visit(

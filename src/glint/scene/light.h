@@ -71,18 +71,24 @@ namespace light_detail {
 inline Color attenuate(const Color& intensity, const Attenuation& a, double d) {
   return intensity / (a.kc + a.kl * d + a.kq * d * d);
 }
+
+// l and d from a positional light to p; false when p is the light's position (l undefined).
+inline bool towardPoint(const Point3& lightPosition, const Point3& p, LightSample& sample) {
+  const Vec3 offset = p - lightPosition;
+  const double d = length(offset);
+  if (!(d > 0)) return false;
+  sample.toPoint = offset / d;
+  sample.distance = d;
+  return true;
+}
 }  // namespace light_detail
 
 // illuminate() of a point light, inline for the renderer's light loop (the variant overload below
 // gives the same bits: it calls this one).
 inline LightSample illuminate(const PointLight& light, const Point3& p) {
   LightSample sample;
-  const Vec3 offset = p - light.position;
-  const double d = length(offset);
-  if (!(d > 0)) return sample;  // P at the light: l undefined, zero intensity
-  sample.toPoint = offset / d;
-  sample.distance = d;
-  sample.intensity = light_detail::attenuate(light.intensity, light.attenuation, d);
+  if (!light_detail::towardPoint(light.position, p, sample)) return sample;  // zero intensity
+  sample.intensity = light_detail::attenuate(light.intensity, light.attenuation, sample.distance);
   return sample;
 }
 
