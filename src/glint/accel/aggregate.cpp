@@ -98,9 +98,11 @@ inline void floatBracket(__m128d xy, __m128d z, __m128& below, __m128& above) {
   above = stepWhere<true>(f, below64);
 }
 
-template <int kLane>
-inline __m128 broadcast(__m128 v) {
-  return _mm_shuffle_ps(v, v, _MM_SHUFFLE(kLane, kLane, kLane, kLane));
+// Lanes 0, 1, 2 of v, each broadcast to all four lanes of its own register (one per axis).
+inline void broadcastAxes(__m128 v, __m128 (&axes)[3]) {
+  axes[0] = _mm_shuffle_ps(v, v, _MM_SHUFFLE(0, 0, 0, 0));
+  axes[1] = _mm_shuffle_ps(v, v, _MM_SHUFFLE(1, 1, 1, 1));
+  axes[2] = _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 2, 2, 2));
 }
 
 // Byte offsets of the rows of Node::bounds (0–2 low, 3–5 high) a slab test reads per axis, for each
@@ -151,18 +153,10 @@ struct BoxRay {
     const __m128 negative = _mm_castsi128_ps(_mm_srai_epi32(_mm_castps_si128(nearInv), 31));
     const __m128 nearO = _mm_or_ps(_mm_and_ps(negative, below), _mm_andnot_ps(negative, above));
     const __m128 farO = _mm_or_ps(_mm_and_ps(negative, above), _mm_andnot_ps(negative, below));
-    nearOrigin[0] = broadcast<0>(nearO);
-    nearOrigin[1] = broadcast<1>(nearO);
-    nearOrigin[2] = broadcast<2>(nearO);
-    farOrigin[0] = broadcast<0>(farO);
-    farOrigin[1] = broadcast<1>(farO);
-    farOrigin[2] = broadcast<2>(farO);
-    nearInverse[0] = broadcast<0>(nearInv);
-    nearInverse[1] = broadcast<1>(nearInv);
-    nearInverse[2] = broadcast<2>(nearInv);
-    farInverse[0] = broadcast<0>(farInv);
-    farInverse[1] = broadcast<1>(farInv);
-    farInverse[2] = broadcast<2>(farInv);
+    broadcastAxes(nearO, nearOrigin);
+    broadcastAxes(farO, farOrigin);
+    broadcastAxes(nearInv, nearInverse);
+    broadcastAxes(farInv, farInverse);
     rows = kSlabRows[static_cast<unsigned>(_mm_movemask_ps(negative)) & 7u];
   }
 };
