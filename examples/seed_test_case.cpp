@@ -10,7 +10,7 @@
 #include <string>
 
 #include "../tests/seed_scene.h"
-#include "glint/io/image_writer.h"
+#include "glint/image/image_writer.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/scene.h"
 

@@ -23,7 +23,7 @@
 #include <system_error>
 
 #include "glint/core/transform.h"
-#include "glint/io/mesh_loader.h"
+#include "glint/mesh/mesh_loader.h"
 
 namespace glint::fuzz {
 

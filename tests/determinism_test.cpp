@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "glint/geometry/shape.h"
-#include "glint/io/image_writer.h"
+#include "glint/image/image_writer.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/scene.h"
 #include "test_scenes.h"

@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "glint/geometry/shape.h"
-#include "glint/io/image_writer.h"
+#include "glint/image/image_writer.h"
 #include "glint/scene/scene.h"
 
 namespace glint::seed {

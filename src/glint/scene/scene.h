@@ -1,5 +1,5 @@
 // The frozen scene: primitives in their acceleration structure, materials, lights, camera and the
-// image and render settings. Built once (by code or by io/scene_builder), then only queried
+// image and render settings. Built once (by code or by factories/scene_builder), then only queried
 // (const), shared by all render threads without locks.
 #pragma once
 

@@ -1,4 +1,4 @@
-#include "glint/io/yaml_tree.h"
+#include "glint/readers/yaml_tree.h"
 
 #include <yaml-cpp/anchor.h>
 #include <yaml-cpp/depthguard.h>

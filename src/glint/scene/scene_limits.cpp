@@ -1,4 +1,4 @@
-#include "glint/io/scene_limits.h"
+#include "glint/scene/scene_limits.h"
 
 #include <unistd.h>
 

@@ -1,7 +1,7 @@
 // SceneDescription: a scene file as plain data (DESIGN.md §5), with the file:line:col of every
 // entity and value, before any validation of ranges or construction of render objects. Filled by
-// io/scene_parser (structure, types, unknown/duplicate/missing keys, conflicts, finiteness) and
-// turned into SceneParts by io/scene_builder (ranges, references, colours, shapes).
+// readers/scene_parser (structure, types, unknown/duplicate/missing keys, conflicts, finiteness) and
+// turned into SceneParts by factories/scene_builder (ranges, references, colours, shapes).
 #pragma once
 
 #include <array>
@@ -13,7 +13,7 @@
 
 #include "glint/core/color.h"
 #include "glint/core/vec.h"
-#include "glint/io/diagnostics.h"
+#include "glint/readers/diagnostics.h"
 #include "glint/scene/scene.h"
 
 namespace glint {
@@ -55,7 +55,7 @@ enum class ShapeType {
   Cylinder,
   Box,
   Disk,
-  Mesh  // triangles from a mesh file, loaded by the builder (io/mesh_loader)
+  Mesh  // triangles from a mesh file, loaded by the builder (mesh/mesh_loader)
 };
 
 // One transform step: translate by `vector`, scale by `vector` (sx, sy, sz), or rotate by `angle`

@@ -1,4 +1,4 @@
-#include "glint/io/checkpoint.h"
+#include "glint/job/checkpoint.h"
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -13,7 +13,7 @@
 #include <system_error>
 #include <utility>
 
-#include "glint/io/scene_limits.h"
+#include "glint/scene/scene_limits.h"
 #include "glint/render/renderer.h"
 
 namespace glint {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "glint/io/diagnostics.h"
-#include "glint/io/scene_loader.h"
+#include "glint/readers/diagnostics.h"
+#include "glint/factories/scene_loader.h"
 
 namespace glint::testing {
 

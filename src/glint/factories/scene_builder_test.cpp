@@ -1,7 +1,7 @@
 // Scene building (DESIGN.md §5, §7): SceneDescription → SceneParts values, colour decoding under
 // both encodings, transforms, normalisation, range checks at the value's place, shape errors at the
 // object's place, the image size limits, and warnings.
-#include "glint/io/scene_builder.h"
+#include "glint/factories/scene_builder.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -19,10 +19,10 @@
 
 #include <fmt/format.h>
 
-#include "glint/io/scene_limits.h"
-#include "glint/io/scene_loader.h"
-#include "glint/io/scene_parser.h"
-#include "glint/io/scene_test_support.h"
+#include "glint/scene/scene_limits.h"
+#include "glint/factories/scene_loader.h"
+#include "glint/readers/scene_parser.h"
+#include "glint/factories/scene_test_support.h"
 #include "glint/scene/scene.h"
 
 namespace glint {

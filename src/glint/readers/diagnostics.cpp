@@ -1,4 +1,4 @@
-#include "glint/io/diagnostics.h"
+#include "glint/readers/diagnostics.h"
 
 #include <string>
 #include <utility>

@@ -1,4 +1,4 @@
-#include "glint/io/scene_overrides.h"
+#include "glint/job/scene_overrides.h"
 
 #include <algorithm>
 #include <limits>

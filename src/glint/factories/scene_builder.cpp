@@ -1,4 +1,4 @@
-#include "glint/io/scene_builder.h"
+#include "glint/factories/scene_builder.h"
 
 #include <cmath>
 #include <cstdint>
@@ -18,8 +18,8 @@
 
 #include "glint/core/transform.h"
 #include "glint/geometry/shape.h"
-#include "glint/io/mesh_loader.h"
-#include "glint/io/spelling.h"
+#include "glint/mesh/mesh_loader.h"
+#include "glint/readers/spelling.h"
 #include "glint/scene/camera.h"
 
 namespace glint {

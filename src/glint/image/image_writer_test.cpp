@@ -1,4 +1,4 @@
-#include "glint/io/image_writer.h"
+#include "glint/image/image_writer.h"
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>

@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include "glint/io/scene_limits.h"
+#include "glint/scene/scene_limits.h"
 #include "glint/render/film.h"
 #include "glint/scene/scene.h"
 

@@ -1,5 +1,5 @@
 // Scene files (DESIGN.md §5): YAML/JSON text → SceneDescription (plain data with the file:line:col
-// of every entity; io/scene_description.h) → SceneParts (render objects; scene/scene.h). Strict: an
+// of every entity; readers/scene_description.h) → SceneParts (render objects; scene/scene.h). Strict: an
 // unknown key, a wrong type, a missing required key or an invalid value is an error naming its
 // place.
 #pragma once
@@ -10,8 +10,8 @@
 #include <string_view>
 #include <vector>
 
-#include "glint/io/diagnostics.h"
-#include "glint/io/scene_limits.h"
+#include "glint/readers/diagnostics.h"
+#include "glint/scene/scene_limits.h"
 #include "glint/scene/scene.h"
 
 namespace glint {

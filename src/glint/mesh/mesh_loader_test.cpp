@@ -3,7 +3,7 @@
 // counts, bounds and materials the tests read from the files themselves; normals (file, generated,
 // crease angle, repaired), the instancing transform, degenerate and invalid triangles, the cache
 // and the reasons a file is refused.
-#include "glint/io/mesh_loader.h"
+#include "glint/mesh/mesh_loader.h"
 
 #include <fmt/format.h>
 #include <gmock/gmock.h>
@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "glint/core/bounds.h"
-#include "glint/io/yaml_tree.h"
+#include "glint/readers/yaml_tree.h"
 
 namespace glint {
 namespace {

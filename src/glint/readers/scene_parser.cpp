@@ -1,4 +1,4 @@
-#include "glint/io/scene_parser.h"
+#include "glint/readers/scene_parser.h"
 
 #include <array>
 #include <charconv>
@@ -13,8 +13,8 @@
 
 #include <fmt/format.h>
 
-#include "glint/io/spelling.h"
-#include "glint/io/yaml_tree.h"
+#include "glint/readers/spelling.h"
+#include "glint/readers/yaml_tree.h"
 
 namespace glint {
 

@@ -1,5 +1,5 @@
 // PNG (libpng), PPM (P6) and OpenEXR writers behind one atomic write-then-rename policy.
-#include "glint/io/image_writer.h"
+#include "glint/image/image_writer.h"
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>

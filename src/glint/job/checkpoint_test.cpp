@@ -1,4 +1,4 @@
-#include "glint/io/checkpoint.h"
+#include "glint/job/checkpoint.h"
 
 #include <gtest/gtest.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-#include "glint/io/scene_loader.h"
+#include "glint/factories/scene_loader.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "glint/io/scene_builder.h"
-#include "glint/io/scene_parser.h"
+#include "glint/factories/scene_builder.h"
+#include "glint/readers/scene_parser.h"
 
 namespace glint {
 namespace {

@@ -1,6 +1,6 @@
 // Scene-file parsing (DESIGN.md §5, §7): the text → SceneDescription half, and the error reporting
 // of loadSceneFromString for problems of structure, type and syntax, each at its line and column.
-#include "glint/io/scene_parser.h"
+#include "glint/readers/scene_parser.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 #include <variant>
 #include <vector>
 
-#include "glint/io/scene_loader.h"
-#include "glint/io/scene_test_support.h"
+#include "glint/factories/scene_loader.h"
+#include "glint/factories/scene_test_support.h"
 
 namespace glint {
 namespace {

@@ -10,8 +10,8 @@
 #include <string_view>
 #include <vector>
 
-#include "glint/io/diagnostics.h"
-#include "glint/io/scene_description.h"
+#include "glint/readers/diagnostics.h"
+#include "glint/readers/scene_description.h"
 
 namespace glint {
 

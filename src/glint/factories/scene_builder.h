@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "glint/io/diagnostics.h"
-#include "glint/io/scene_description.h"
-#include "glint/io/scene_limits.h"
+#include "glint/readers/diagnostics.h"
+#include "glint/readers/scene_description.h"
+#include "glint/scene/scene_limits.h"
 #include "glint/scene/scene.h"
 
 namespace glint {

@@ -2,7 +2,7 @@
 // alias bombs (nested and one-level), an alias inside its own anchor, deep nesting, a file past
 // the 256 MiB cap, and a mesh whose estimated memory (mesh + BVH, with the film) exceeds the
 // loader's memory budget — each an error at its place in the file.
-#include "glint/io/scene_limits.h"
+#include "glint/scene/scene_limits.h"
 
 #include <fcntl.h>
 #include <gmock/gmock.h>
@@ -17,9 +17,9 @@
 
 #include <fmt/format.h>
 
-#include "glint/io/mesh_loader.h"
-#include "glint/io/scene_loader.h"
-#include "glint/io/scene_test_support.h"
+#include "glint/mesh/mesh_loader.h"
+#include "glint/factories/scene_loader.h"
+#include "glint/factories/scene_test_support.h"
 
 namespace glint {
 namespace {

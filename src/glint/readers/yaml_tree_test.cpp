@@ -3,7 +3,7 @@
 // "billion laughs" and one-level repetition of a large list), an alias inside its own anchor and
 // more nodes than the limit are refused at the offending place; nesting deeper than yaml-cpp's
 // guard is reported as such.
-#include "glint/io/yaml_tree.h"
+#include "glint/readers/yaml_tree.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "glint/io/mesh_loader.h"
+#include "glint/mesh/mesh_loader.h"
 
 #include <fcntl.h>
 #include <malloc.h>
@@ -39,8 +39,8 @@
 #include <fmt/format.h>
 #include <assimp/Importer.hpp>
 
-#include "glint/io/scene_limits.h"
-#include "glint/io/yaml_tree.h"
+#include "glint/scene/scene_limits.h"
+#include "glint/readers/yaml_tree.h"
 
 namespace glint {
 
