@@ -35,7 +35,7 @@
 #include "glint/image/image_writer.h"
 #include "glint/scene/scene_limits.h"
 #include "glint/factories/scene_loader.h"
-#include "glint/job/scene_overrides.h"
+#include "glint/scene/scene_overrides.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/light.h"
 #include "glint/scene/scene.h"
@@ -220,9 +220,10 @@ void printDiagnostics(const std::vector<Diagnostic>& diagnostics) {
 }
 
 LoadedScene load(const std::string& file, bool showWarnings,
-                 std::uint64_t memoryBudget = defaultImageMemoryBudget()) {
+                 std::uint64_t memoryBudget = defaultImageMemoryBudget(),
+                 const SceneOverrides& overrides = {}) {
   try {
-    LoadedScene loaded = loadScene(file, LoadOptions{memoryBudget});
+    LoadedScene loaded = loadScene(file, LoadOptions{memoryBudget, overrides});
     if (showWarnings) printDiagnostics(loaded.warnings);
     return loaded;
   } catch (const SceneError& error) {
@@ -467,13 +468,6 @@ RenderRequest parseRequest(const RenderArgs& args) {
   return request;
 }
 
-// With adaptive sampling `--samples N` sets the minimum per pixel; a maximum below it rises to N,
-// so the option always means "at least N samples".
-void raiseAdaptiveMaximum(ImageSettings& image) {
-  if (image.adaptive && image.adaptive->maxSamples < image.samples)
-    image.adaptive->maxSamples = image.samples;
-}
-
 // The checkpoint file a render writes: --checkpoint, or else the --resume file (a resumed render
 // keeps checkpointing, so it can be interrupted again). Checked before any work, like the output.
 std::optional<fs::path> resolveCheckpoint(const RenderArgs& args, const fs::path& out) {
@@ -522,9 +516,7 @@ int runRender(const RenderArgs& args, SignalGuard& signals) {
 
   Timings timings;
   auto phase = Clock::now();
-  LoadedScene loaded = load(args.scene, !args.quiet, request.memoryBudget);
-  applyOverrides(loaded.parts, request.overrides);
-  raiseAdaptiveMaximum(loaded.parts.image);
+  LoadedScene loaded = load(args.scene, !args.quiet, request.memoryBudget, request.overrides);
   ImageSettings allocated = loaded.parts.image;
   if (crop) {
     checkCrop(*crop, loaded.parts.image.width, loaded.parts.image.height);

@@ -19,6 +19,7 @@
 #include "glint/core/transform.h"
 #include "glint/geometry/shape.h"
 #include "glint/mesh/mesh_loader.h"
+#include "glint/scene/scene_overrides.h"
 #include "glint/readers/spelling.h"
 #include "glint/scene/camera.h"
 
@@ -205,15 +206,21 @@ class Builder {
       }
       parts_.image.grid = grid;
     }
-    if (sizeOk) {
+    // The caller's --width/--height/--samples replace the scene's values before anything is
+    // estimated from them (the film, the meshes' share of the budget); the caller then checks the
+    // image it asked for against the limits, naming its options.
+    const SceneOverrides& overrides = options_.overrides;
+    const bool overridden = overrides.width || overrides.height || overrides.samples;
+    if (sizeOk && !overridden) {
       // Refused here, before the renderer allocates anything for it.
       if (auto problem = checkImageSettings(parts_.image, options_.imageMemoryBudget)) {
         error(image.where, "image: " + *problem);
         sizeOk = false;
       }
     }
-    if (image.adaptive) buildAdaptive(*image.adaptive, sizeOk);
+    if (image.adaptive) buildAdaptive(*image.adaptive, sizeOk && !overridden);
     imageOk_ = sizeOk && errorCount() == errorsBefore;
+    if (imageOk_ && overridden) applyImageOverrides(parts_.image, overrides);
   }
 
   // image.adaptive, after image.samples: max_samples may not be below the fixed count, and the
@@ -254,6 +261,7 @@ class Builder {
   }
 
   void buildRender() {
+    if (options_.overrides.seed) parts_.render.seed = *options_.overrides.seed;
     if (!d_.render) return;
     const RenderDescription& render = *d_.render;
     if (render.maxDepth && inRange(*render.maxDepth, 1, kMaxRenderDepth, "render.max_depth")) {
@@ -267,6 +275,7 @@ class Builder {
       parts_.render.blurSamples = static_cast<int>(render.blurSamples->value);
     }
     if (render.seed) parts_.render.seed = render.seed->value;
+    if (options_.overrides.seed) parts_.render.seed = *options_.overrides.seed;
   }
 
   void buildAmbient() {

@@ -11,12 +11,16 @@
 #include "glint/readers/scene_description.h"
 #include "glint/scene/scene_limits.h"
 #include "glint/scene/scene.h"
+#include "glint/scene/scene_overrides.h"
 
 namespace glint {
 
 struct BuildOptions {
   // Largest film (width · height · sizeof(Color) bytes) the image may ask for.
   std::uint64_t imageMemoryBudget = defaultImageMemoryBudget();
+  // The caller's replacements of the image size, samples and seed, applied before the film and the
+  // meshes are estimated; the caller checks the overridden image against the limits.
+  SceneOverrides overrides{};
 };
 
 struct BuildResult {

@@ -19,11 +19,11 @@
 
 #include <fmt/format.h>
 
-#include "glint/scene/scene_limits.h"
 #include "glint/factories/scene_loader.h"
-#include "glint/readers/scene_parser.h"
 #include "glint/factories/scene_test_support.h"
+#include "glint/readers/scene_parser.h"
 #include "glint/scene/scene.h"
+#include "glint/scene/scene_limits.h"
 
 namespace glint {
 namespace {
@@ -473,7 +473,8 @@ TEST(SceneBuilder, HugeImageRefusedBeforeAllocation) {
       "image:\n  width: 2000\n  height: 1000\n",
       "big.yaml");
   ASSERT_FALSE(parsed.hasErrors());
-  const BuildResult built = buildScene(parsed.description, BuildOptions{std::uint64_t{16} << 20});
+  const BuildResult built =
+      buildScene(parsed.description, BuildOptions{.imageMemoryBudget = std::uint64_t{16} << 20});
   ASSERT_EQ(built.diagnostics.size(), 1u);
   EXPECT_EQ(built.diagnostics[0].format(),
             "big.yaml:3:3: image: an image of 2000 × 1000 pixels needs 45.8 MiB for its film, more "

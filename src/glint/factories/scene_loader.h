@@ -13,6 +13,7 @@
 #include "glint/readers/diagnostics.h"
 #include "glint/scene/scene_limits.h"
 #include "glint/scene/scene.h"
+#include "glint/scene/scene_overrides.h"
 
 namespace glint {
 
@@ -25,6 +26,8 @@ struct LoadOptions {
   // Bytes the scene may need (film now; meshes and BVH estimated before loading): the limit of
   // DESIGN.md §7, set by `--max-memory`.
   std::uint64_t memoryBudget = defaultImageMemoryBudget();
+  // --width/--height/--samples/--seed, applied before anything is estimated from the image.
+  SceneOverrides overrides{};
 };
 
 // Reads, parses and builds a scene file. Throws SceneError carrying every error found (up to 20);

@@ -17,9 +17,9 @@
 
 #include <fmt/format.h>
 
-#include "glint/mesh/mesh_loader.h"
 #include "glint/factories/scene_loader.h"
 #include "glint/factories/scene_test_support.h"
+#include "glint/mesh/mesh_loader.h"
 
 namespace glint {
 namespace {
@@ -125,7 +125,7 @@ class MeshBudgetTest : public ::testing::Test {
         std::string(kMinimal) + "lights: [{type: point, position: [0, 0, 5]}]\n" + "objects:\n";
     for (int i = 0; i < objects; ++i) text += "  - {type: mesh, file: strip.obj}\n";
     try {
-      loadSceneFromString(text, "test.yaml", folder_, LoadOptions{budget});
+      loadSceneFromString(text, "test.yaml", folder_, LoadOptions{.memoryBudget = budget});
     } catch (const SceneError& e) {
       return e.diagnostics();
     }

@@ -1,4 +1,4 @@
-#include "glint/job/scene_overrides.h"
+#include "glint/scene/scene_overrides.h"
 
 #include <algorithm>
 #include <limits>
@@ -26,12 +26,20 @@ ImageSize resizeKeepingAspect(const ImageSize& current, std::optional<int> width
   return current;
 }
 
+void applyImageOverrides(ImageSettings& image, const SceneOverrides& overrides) {
+  const ImageSize size =
+      resizeKeepingAspect({image.width, image.height}, overrides.width, overrides.height);
+  image.width = size.width;
+  image.height = size.height;
+  if (overrides.samples) image.samples = *overrides.samples;
+  // With adaptive sampling the samples are the minimum per pixel; a maximum below it rises to it,
+  // so --samples N always means "at least N samples".
+  if (image.adaptive && image.adaptive->maxSamples < image.samples)
+    image.adaptive->maxSamples = image.samples;
+}
+
 void applyOverrides(SceneParts& parts, const SceneOverrides& overrides) {
-  const ImageSize size = resizeKeepingAspect({parts.image.width, parts.image.height},
-                                             overrides.width, overrides.height);
-  parts.image.width = size.width;
-  parts.image.height = size.height;
-  if (overrides.samples) parts.image.samples = *overrides.samples;
+  applyImageOverrides(parts.image, overrides);
   if (overrides.seed) parts.render.seed = *overrides.seed;
 }
 

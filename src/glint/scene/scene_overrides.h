@@ -30,6 +30,10 @@ struct SceneOverrides {
 ImageSize resizeKeepingAspect(const ImageSize& current, std::optional<int> width,
                               std::optional<int> height);
 
+// Applies the size and samples overrides to `image`; an adaptive maximum below the samples rises
+// to them.
+void applyImageOverrides(ImageSettings& image, const SceneOverrides& overrides);
+
 // Applies the overrides to parts.image and parts.render. Values are not range-checked here: the
 // caller re-runs the scene's image limits afterwards.
 void applyOverrides(SceneParts& parts, const SceneOverrides& overrides);

@@ -1,4 +1,4 @@
-#include "glint/job/scene_overrides.h"
+#include "glint/scene/scene_overrides.h"
 
 #include <gtest/gtest.h>
 
