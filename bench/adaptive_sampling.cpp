@@ -36,8 +36,8 @@
 
 #include "bench_support.h"
 #include "glint/core/color.h"
-#include "glint/readers/diagnostics.h"
 #include "glint/factories/scene_loader.h"
+#include "glint/readers/diagnostics.h"
 #include "glint/render/film.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/scene.h"

@@ -5,8 +5,8 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "glint/readers/diagnostics.h"
 #include "glint/factories/scene_loader.h"
+#include "glint/readers/diagnostics.h"
 
 namespace {
 

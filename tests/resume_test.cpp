@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "glint/job/checkpoint.h"
 #include "glint/factories/scene_loader.h"
+#include "glint/job/checkpoint.h"
 #include "glint/render/renderer.h"
 
 namespace glint {

@@ -30,15 +30,15 @@
 
 #include "glint/cli/progress_reporter.h"
 #include "glint/cli/signal_guard.h"
+#include "glint/factories/scene_loader.h"
+#include "glint/image/image_writer.h"
 #include "glint/job/checkpoint.h"
 #include "glint/readers/diagnostics.h"
-#include "glint/image/image_writer.h"
-#include "glint/scene/scene_limits.h"
-#include "glint/factories/scene_loader.h"
-#include "glint/scene/scene_overrides.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/light.h"
 #include "glint/scene/scene.h"
+#include "glint/scene/scene_limits.h"
+#include "glint/scene/scene_overrides.h"
 
 namespace glint::cli {
 namespace {

@@ -19,9 +19,9 @@
 #include "glint/core/transform.h"
 #include "glint/geometry/shape.h"
 #include "glint/mesh/mesh_loader.h"
-#include "glint/scene/scene_overrides.h"
 #include "glint/readers/spelling.h"
 #include "glint/scene/camera.h"
+#include "glint/scene/scene_overrides.h"
 
 namespace glint {
 

@@ -9,8 +9,8 @@
 
 #include "glint/readers/diagnostics.h"
 #include "glint/readers/scene_description.h"
-#include "glint/scene/scene_limits.h"
 #include "glint/scene/scene.h"
+#include "glint/scene/scene_limits.h"
 #include "glint/scene/scene_overrides.h"
 
 namespace glint {

@@ -1,7 +1,7 @@
 // Scene files (DESIGN.md §5): YAML/JSON text → SceneDescription (plain data with the file:line:col
-// of every entity; readers/scene_description.h) → SceneParts (render objects; scene/scene.h). Strict: an
-// unknown key, a wrong type, a missing required key or an invalid value is an error naming its
-// place.
+// of every entity; readers/scene_description.h) → SceneParts (render objects; scene/scene.h).
+// Strict: an unknown key, a wrong type, a missing required key or an invalid value is an error
+// naming its place.
 #pragma once
 
 #include <cstdint>
@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "glint/readers/diagnostics.h"
-#include "glint/scene/scene_limits.h"
 #include "glint/scene/scene.h"
+#include "glint/scene/scene_limits.h"
 #include "glint/scene/scene_overrides.h"
 
 namespace glint {

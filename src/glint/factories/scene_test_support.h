@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "glint/readers/diagnostics.h"
 #include "glint/factories/scene_loader.h"
+#include "glint/readers/diagnostics.h"
 
 namespace glint::testing {
 

@@ -13,8 +13,8 @@
 #include <system_error>
 #include <utility>
 
-#include "glint/scene/scene_limits.h"
 #include "glint/render/renderer.h"
+#include "glint/scene/scene_limits.h"
 
 namespace glint {
 namespace {

@@ -13,9 +13,9 @@
 #include <string_view>
 #include <vector>
 
-#include "glint/scene/scene_limits.h"
 #include "glint/render/film.h"
 #include "glint/scene/scene.h"
+#include "glint/scene/scene_limits.h"
 
 namespace glint {
 

@@ -39,8 +39,8 @@
 #include <fmt/format.h>
 #include <assimp/Importer.hpp>
 
-#include "glint/scene/scene_limits.h"
 #include "glint/readers/yaml_tree.h"
+#include "glint/scene/scene_limits.h"
 
 namespace glint {
 

@@ -1,7 +1,7 @@
 // SceneDescription: a scene file as plain data (DESIGN.md §5), with the file:line:col of every
 // entity and value, before any validation of ranges or construction of render objects. Filled by
-// readers/scene_parser (structure, types, unknown/duplicate/missing keys, conflicts, finiteness) and
-// turned into SceneParts by factories/scene_builder (ranges, references, colours, shapes).
+// readers/scene_parser (structure, types, unknown/duplicate/missing keys, conflicts, finiteness)
+// and turned into SceneParts by factories/scene_builder (ranges, references, colours, shapes).
 #pragma once
 
 #include <array>
