@@ -4,6 +4,7 @@
 // naming its place.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -28,6 +29,9 @@ struct LoadOptions {
   std::uint64_t memoryBudget = defaultImageMemoryBudget();
   // --width/--height/--samples/--seed, applied before anything is estimated from the image.
   SceneOverrides overrides{};
+  // Polled while reading, parsing, loading meshes and building; when set the load throws
+  // Cancelled (core/cancel.h). Not owned; may be null.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 // Reads, parses and builds a scene file. Throws SceneError carrying every error found (up to 20);
