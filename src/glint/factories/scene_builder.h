@@ -1,27 +1,18 @@
-// The scene builder: SceneDescription → SceneParts (DESIGN.md §5, §7). Checks value ranges,
-// resolves material names, decodes colours under the image encoding, normalises directions,
-// composes transforms and creates the shapes through their make() factories, reporting every
-// problem at the place in the file it comes from. The only io code that creates render objects.
+// The scene builder: SceneDescription → SceneParts (DESIGN.md §5, §7, §8). Walks the entities in
+// order — image first (its encoding decodes every "#rrggbb"), then render, background, ambient,
+// camera, materials, objects, lights — hands each to the factory of its type, reports every
+// parameter nothing read as an unknown key, resolves material names and reads mesh files. The only
+// code that turns scene files into render objects.
 #pragma once
 
-#include <cstdint>
 #include <vector>
 
+#include "glint/factories/build_context.h"
 #include "glint/readers/diagnostics.h"
 #include "glint/readers/scene_description.h"
 #include "glint/scene/scene.h"
-#include "glint/scene/scene_limits.h"
-#include "glint/scene/scene_overrides.h"
 
 namespace glint {
-
-struct BuildOptions {
-  // Largest film (width · height · sizeof(Color) bytes) the image may ask for.
-  std::uint64_t imageMemoryBudget = defaultImageMemoryBudget();
-  // The caller's replacements of the image size, samples and seed, applied before the film and the
-  // meshes are estimated; the caller checks the overridden image against the limits.
-  SceneOverrides overrides{};
-};
 
 struct BuildResult {
   SceneParts parts;                     // complete only when there is no error
@@ -29,8 +20,8 @@ struct BuildResult {
   bool hasErrors() const;
 };
 
-// Builds whatever the description holds. Required parts that are absent are reported only for
-// entities the parser marked complete (the parser has already reported the others).
+// Builds whatever the description holds. A missing camera or image is reported here only when the
+// reader reported nothing (it reports them itself for files it read).
 BuildResult buildScene(const SceneDescription& description, const BuildOptions& options = {});
 
 }  // namespace glint

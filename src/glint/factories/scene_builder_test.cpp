@@ -21,7 +21,7 @@
 
 #include "glint/factories/scene_loader.h"
 #include "glint/factories/scene_test_support.h"
-#include "glint/readers/scene_parser.h"
+#include "glint/readers/yaml_scene_reader.h"
 #include "glint/scene/scene.h"
 #include "glint/scene/scene_limits.h"
 
@@ -33,6 +33,51 @@ using testing::expectOneError;
 using ::testing::HasSubstr;
 using testing::kDesignExample;
 using testing::kMinimal;
+
+// A description made by hand, as a reader of another format would make it: values added to the
+// tree with their places, entities pointing at their mappings.
+class HandMade {
+ public:
+  explicit HandMade(const std::string& file) { d.addFile(file, "."); }
+  SceneDescription d;
+  ValueTree& tree() { return d.files[0]->values; }
+  static TextPosition at(std::uint32_t line, std::uint32_t column) {
+    return {line * 1000 + column, line, column};
+  }
+  // A mapping of scalar keys and values, each value at its own place (line, column).
+  struct Entry {
+    std::string key;
+    std::vector<std::string> value;  // one scalar, or the items of a list
+    std::uint32_t line = 0, column = 0;
+  };
+  ValueId map(std::uint32_t line, std::uint32_t column, const std::vector<Entry>& entries) {
+    const ValueId id = tree().open(ValueKind::Map, at(line, column));
+    for (const Entry& e : entries) {
+      tree().addScalar(e.key, at(e.line, e.column > 1 ? e.column - 1 : 1));
+      if (e.value.size() == 1) {
+        tree().addScalar(e.value[0], at(e.line, e.column));
+      } else {
+        tree().open(ValueKind::List, at(e.line, e.column));
+        for (const std::string& item : e.value) tree().addScalar(item, at(e.line, e.column + 1));
+        tree().close();
+      }
+    }
+    tree().close();
+    return id;
+  }
+  void entity(EntityKind kind, ValueId value, std::string_view type = {}) {
+    Entity e;
+    e.kind = kind;
+    e.value = value;
+    e.place = value;
+    if (!type.empty()) {
+      for (std::size_t i = 0; i < tree().size(value); ++i) {
+        if (tree().scalar(tree().key(value, i)) == "type") e.type = tree().value(value, i);
+      }
+    }
+    d.entities.push_back(e);
+  }
+};
 
 // Loads a scene that must be valid.
 SceneParts partsOf(const std::string& text) {
@@ -404,33 +449,36 @@ TEST(SceneBuilder, DegenerateShapesAtTheKeyTheyName) {
 }
 
 TEST(SceneBuilder, BuildsHandMadeDescriptions) {
-  SceneDescription d;
-  d.file = "made.yaml";
+  HandMade made("made.yaml");
   // Complete entities missing required parts are reported by the builder itself.
-  BuildResult r = buildScene(d);
+  BuildResult r = buildScene(made.d);
   ASSERT_EQ(r.diagnostics.size(), 2u);
   EXPECT_THAT(r.diagnostics[0].message, HasSubstr("missing required key 'image'"));
   EXPECT_THAT(r.diagnostics[1].message, HasSubstr("missing required key 'camera'"));
 
-  d.image = ImageDescription{};
-  d.image->width = Located<std::int64_t>{640, {"made.yaml", 2, 3}};
-  d.image->height = Located<std::int64_t>{480, {"made.yaml", 3, 3}};
-  d.camera = CameraDescription{};
-  d.camera->position = Located<Point3>{{0, 0, 0}, {}};
-  d.camera->direction = Located<Vec3>{{0, 0, -2}, {}};
-  d.camera->fov = Located<double>{60, {}};
-  ObjectDescription sphere;
-  sphere.type = ShapeType::Sphere;
-  sphere.typeName = "sphere";
-  sphere.center = Located<Point3>{{0, 0, -5}, {}};
-  sphere.radius = Located<double>{-1, {"made.yaml", 9, 13}};
-  d.objects.push_back(sphere);
-  r = buildScene(d);
+  const auto scene = [](const std::string& radius) {
+    HandMade m("made.yaml");
+    m.entity(EntityKind::ImageEntity,
+             m.map(1, 1, {{"width", {"640"}, 2, 3}, {"height", {"480"}, 3, 3}}));
+    m.entity(EntityKind::CameraEntity, m.map(4, 1,
+                                             {{"position", {"0", "0", "0"}, 5, 3},
+                                              {"direction", {"0", "0", "-2"}, 6, 3},
+                                              {"fov", {"60"}, 7, 3}}));
+    m.entity(EntityKind::ObjectEntity,
+             m.map(8, 1,
+                   {{"type", {"sphere"}, 8, 9},
+                    {"center", {"0", "0", "-5"}, 8, 30},
+                    {"radius", {radius}, 9, 13}}),
+             "sphere");
+    return m;
+  };
+  HandMade bad = scene("-1");
+  r = buildScene(bad.d);
   ASSERT_EQ(r.diagnostics.size(), 1u);
   EXPECT_EQ(r.diagnostics[0].format(), "made.yaml:9:13: sphere.radius must be > 0, got -1");
 
-  d.objects[0].radius->value = 2;
-  r = buildScene(d);
+  HandMade good = scene("2");
+  r = buildScene(good.d);
   EXPECT_FALSE(r.hasErrors());
   EXPECT_EQ(r.parts.camera.direction, (Vec3{0, 0, -1}));
   EXPECT_EQ(r.parts.camera.imageWidth, 640);
@@ -506,7 +554,8 @@ TEST(SceneBuilder, Warnings) {
 
   const LoadedScene off =
       loadSceneFromString(std::string(kMinimal) +
-                              "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1}\n"
+                              "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1, "
+                              "material: {kd: 1}}\n"
                               "lights:\n"
                               "  - {type: point, position: [0, 0, 0]}\n"
                               "  - {type: point, position: [0, 0, 0], intensity: 0}\n"
@@ -525,6 +574,35 @@ TEST(SceneBuilder, Warnings) {
                               "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1}\n",
                           "lit.yaml")
           .warnings.empty());
+}
+
+TEST(SceneBuilder, ObjectsThatReflectNoLightUnderLightsAreWarnings) {
+  // Under a light, an object without a material (or with one of all-zero kd, ks, kr, kt) shows
+  // only the ambient light: one warning at the object, naming why.
+  const LoadedScene dark = loadSceneFromString(
+      std::string(kMinimal) +
+          "materials: {black: {ka: 0.5}}\n"
+          "objects:\n"
+          "  - {type: sphere, center: [0, 0, -5], radius: 1}\n"
+          "  - {type: box, min: [0, 0, -9], max: [1, 1, -8], material: black}\n"
+          "  - {type: sphere, center: [0, 2, -5], radius: 1, emission: [1, 0, 0]}\n"
+          "  - {type: sphere, center: [0, 4, -5], radius: 1, material: {kd: 0.5}}\n"
+          "lights: [{type: point, position: [0, 0, 5]}]\n",
+      "dark.yaml");
+  ASSERT_EQ(dark.warnings.size(), 2u);
+  EXPECT_EQ(dark.warnings[0].format(),
+            "dark.yaml:5:5: warning: sphere has no material, so it reflects no light: under the "
+            "lights it shows only the ambient light (give it a material with kd or ks)");
+  EXPECT_EQ(dark.warnings[1].format(),
+            "dark.yaml:6:5: warning: box's material reflects no light (kd, ks, kr and kt are all "
+            "0): under the lights it shows only the ambient light");
+  // Many such objects: a few warnings and a count of the rest.
+  std::string many =
+      std::string(kMinimal) + "lights: [{type: point, position: [0, 0, 5]}]\nobjects:\n";
+  for (int i = 0; i < 9; ++i) many += "  - {type: sphere, center: [0, 0, -5], radius: 1}\n";
+  const LoadedScene manyDark = loadSceneFromString(many, "many.yaml");
+  ASSERT_EQ(manyDark.warnings.size(), 6u);
+  EXPECT_THAT(manyDark.warnings[0].format(), HasSubstr("4 more objects reflect no light"));
 }
 
 // ------------------------------------------------------------------------------------ mesh objects
@@ -735,14 +813,15 @@ TEST(SceneBuilder, MeshDegenerateTrianglesAreOneWarningAtTheObject) {
   dir.write("some_flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\nf 2 4 1\n");
   const LoadedScene loaded = loadIn(dir, std::string(kMinimal) + kLit +
                                              "objects:\n"
-                                             "  - {type: sphere, center: [0, 0, -5], radius: 1}\n"
+                                             "  - {type: sphere, center: [0, 0, -5], radius: 1,\n"
+                                             "     material: {kd: 1}}\n"
                                              "  - type: mesh\n"
                                              "    file: some_flat.obj\n");
   ASSERT_EQ(loaded.warnings.size(), 1u);
   const Diagnostic& w = loaded.warnings[0];
   EXPECT_EQ(w.severity, Diagnostic::Severity::Warning);
   EXPECT_EQ(w.format(),
-            "meshes.yaml:6:5: warning: mesh file 'some_flat.obj': dropped 2 degenerate triangles "
+            "meshes.yaml:7:5: warning: mesh file 'some_flat.obj': dropped 2 degenerate triangles "
             "(zero area, non-finite or invalid vertices); 1 remain");
   ASSERT_EQ(loaded.parts.meshes.size(), 1u);
   EXPECT_EQ(loaded.parts.meshes[0].triangleCount(), 1u);
@@ -917,39 +996,40 @@ TEST(SceneBuilder, AreaLightErrorsAtTheValue) {
 }
 
 TEST(SceneBuilder, AreaLightHandMadeDescriptions) {
-  SceneDescription d;
-  d.file = "made.yaml";
-  d.image = ImageDescription{};
-  d.image->width = Located<std::int64_t>{64, {}};
-  d.image->height = Located<std::int64_t>{48, {}};
-  d.camera = CameraDescription{};
-  d.camera->position = Located<Point3>{{0, 0, 0}, {}};
-  d.camera->direction = Located<Vec3>{{0, 0, -1}, {}};
-  d.camera->fov = Located<double>{60, {}};
-  LightDescription light;
-  light.type = LightType::Area;
-  light.typeName = "area";
-  light.where = {"made.yaml", 7, 5};
-  d.lights.push_back(light);
-  // A complete light without a surface: the builder reports the missing shape itself.
-  BuildResult r = buildScene(d);
-  ASSERT_EQ(r.diagnostics.size(), 1u);
-  EXPECT_EQ(r.diagnostics[0].format(), "made.yaml:7:5: area light is missing required key 'shape'");
-
-  ObjectDescription disk;
-  disk.type = ShapeType::Disk;
-  disk.typeName = "area light";
-  disk.where = light.where;
-  disk.center = Located<Point3>{{0, 3, 0}, {}};
-  disk.normal = Located<Vec3>{{0, -1, 0}, {}};
-  d.lights[0].surface = disk;
-  r = buildScene(d);
+  const auto scene = [](const std::vector<HandMade::Entry>& light) {
+    HandMade m("made.yaml");
+    m.entity(EntityKind::ImageEntity,
+             m.map(1, 1, {{"width", {"64"}, 2, 3}, {"height", {"48"}, 3, 3}}));
+    m.entity(EntityKind::CameraEntity, m.map(4, 1,
+                                             {{"position", {"0", "0", "0"}, 4, 20},
+                                              {"direction", {"0", "0", "-1"}, 5, 20},
+                                              {"fov", {"60"}, 6, 20}}));
+    m.entity(EntityKind::LightEntity, m.map(7, 5, light), "area");
+    return m;
+  };
+  // A light without a surface: the builder reports the missing shape itself.
+  HandMade noShape = scene({{"type", {"area"}, 7, 12}});
+  BuildResult r = buildScene(noShape.d);
   ASSERT_EQ(r.diagnostics.size(), 1u);
   EXPECT_EQ(r.diagnostics[0].format(),
-            "made.yaml:7:5: area light is missing required key 'radius'");
+            "made.yaml:7:5: area light is missing required key 'shape' (one of: rectangle, disk, "
+            "sphere)");
 
-  d.lights[0].surface->radius = Located<double>{0.5, {}};
-  r = buildScene(d);
+  HandMade noRadius = scene({{"type", {"area"}, 7, 12},
+                             {"shape", {"disk"}, 8, 12},
+                             {"center", {"0", "3", "0"}, 9, 12},
+                             {"normal", {"0", "-1", "0"}, 10, 12}});
+  r = buildScene(noRadius.d);
+  ASSERT_EQ(r.diagnostics.size(), 1u);
+  EXPECT_EQ(r.diagnostics[0].format(),
+            "made.yaml:7:5: disk area light is missing required key 'radius'");
+
+  HandMade disk = scene({{"type", {"area"}, 7, 12},
+                         {"shape", {"disk"}, 8, 12},
+                         {"center", {"0", "3", "0"}, 9, 12},
+                         {"normal", {"0", "-1", "0"}, 10, 12},
+                         {"radius", {"0.5"}, 11, 12}});
+  r = buildScene(disk.d);
   ASSERT_FALSE(r.hasErrors()) << r.diagnostics[0].format();
   const AreaLight& built = std::get<AreaLight>(r.parts.lights.at(0));
   EXPECT_EQ(built.shape, AreaShape::Disk);

@@ -21,6 +21,8 @@ namespace glint {
 struct LoadedScene {
   SceneParts parts;
   std::vector<Diagnostic> warnings;
+  std::uint64_t sceneBytes = 0;        // size of the scene file (or text)
+  std::uint64_t sceneFingerprint = 0;  // 64-bit FNV-1a hash of its bytes
 };
 
 struct LoadOptions {
@@ -34,8 +36,9 @@ struct LoadOptions {
   const std::atomic<bool>* cancel = nullptr;
 };
 
-// Reads, parses and builds a scene file. Throws SceneError carrying every error found (up to 20);
-// a missing, unreadable or directory path is an error naming only the file.
+// Reads (streaming), parses and builds a scene file. Throws SceneError carrying every error found
+// (up to 20); a missing, unreadable or non-regular path (a folder, a FIFO, a device) is an error
+// naming only the file. Throws Cancelled when options.cancel is set while loading.
 LoadedScene loadScene(const std::filesystem::path& file, const LoadOptions& options = {});
 
 // The same for text in memory. `displayName` names the text in messages; relative paths inside it

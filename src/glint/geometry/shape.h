@@ -7,6 +7,8 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -18,11 +20,17 @@
 
 namespace glint {
 
-// Thrown when a shape is built from invalid parameters; what() says why, e.g.
-// "radius must be > 0, got -2". The scene builder adds file:line:col.
+// Thrown when a shape is built from invalid parameters: which parameter (the scene key, e.g.
+// "vertices", "radius", "transform") and what() why, e.g. "vertices are collinear: ...". The scene
+// builder reports it at that parameter's file:line:col.
 class ShapeError : public std::invalid_argument {
  public:
-  using std::invalid_argument::invalid_argument;
+  ShapeError(std::string parameter, const std::string& message)
+      : std::invalid_argument(message), parameter_(std::move(parameter)) {}
+  const std::string& parameter() const { return parameter_; }
+
+ private:
+  std::string parameter_;
 };
 
 // Closest-hit result of one shape, in the space of the ray that was passed in.

@@ -32,27 +32,38 @@ constexpr double kShapeTolerance = 1e-9;
 
 // --- formatting and validation of make() parameters ---
 
+// The scene key a parameter name stands for: "edges[0]" → "edges".
+std::string parameterOf(const char* name) {
+  const std::string_view text(name);
+  return std::string(text.substr(0, text.find('[')));
+}
+
 std::string format(const Vec3& v) { return fmt::format("[{}, {}, {}]", v.x, v.y, v.z); }
 std::string format(const Point3& p) { return fmt::format("[{}, {}, {}]", p.x, p.y, p.z); }
 
 void requireFinite(const char* name, const Point3& p) {
-  if (!isFinite(p)) throw ShapeError(fmt::format("{} must be finite, got {}", name, format(p)));
+  if (!isFinite(p))
+    throw ShapeError(parameterOf(name), fmt::format("{} must be finite, got {}", name, format(p)));
 }
 
 // Unit vector along a direction parameter; rejects non-finite and zero vectors. Dividing by the
 // largest component first keeps huge or tiny (but non-zero) inputs from overflowing or
 // underflowing.
 Vec3 requireDirection(const char* name, const Vec3& v) {
-  if (!isFinite(v)) throw ShapeError(fmt::format("{} must be finite, got {}", name, format(v)));
+  if (!isFinite(v))
+    throw ShapeError(parameterOf(name), fmt::format("{} must be finite, got {}", name, format(v)));
   const double largest = maxComponent(abs(v));
   if (largest == 0)
-    throw ShapeError(fmt::format("{} must be a non-zero vector, got {}", name, format(v)));
+    throw ShapeError(parameterOf(name),
+                     fmt::format("{} must be a non-zero vector, got {}", name, format(v)));
   return normalize(v / largest);
 }
 
 double requirePositive(const char* name, double value) {
-  if (std::isinf(value)) throw ShapeError(fmt::format("{} must be finite, got {}", name, value));
-  if (!(value > 0)) throw ShapeError(fmt::format("{} must be > 0, got {}", name, value));
+  if (std::isinf(value))
+    throw ShapeError(parameterOf(name), fmt::format("{} must be finite, got {}", name, value));
+  if (!(value > 0))
+    throw ShapeError(parameterOf(name), fmt::format("{} must be > 0, got {}", name, value));
   return value;
 }
 
@@ -82,18 +93,20 @@ double vertexSetSize(const Point3* vertices, std::size_t count) {
 Normal3 requirePlanarLoop(const Point3* vertices, std::size_t count) {
   for (std::size_t i = 0; i < count; ++i) {
     if (!isFinite(vertices[i]))
-      throw ShapeError(fmt::format("vertices[{}] must be finite, got {}", i, format(vertices[i])));
+      throw ShapeError("vertices",
+                       fmt::format("vertices[{}] must be finite, got {}", i, format(vertices[i])));
   }
   const double size = vertexSetSize(vertices, count);
   for (std::size_t i = 0; i < count; ++i) {
     const std::size_t j = (i + 1) % count;
     if (distance(vertices[i], vertices[j]) <= kCollinearTolerance * size || size == 0)
-      throw ShapeError(
-          fmt::format("vertices[{}] and [{}] coincide, both {}", i, j, format(vertices[i])));
+      throw ShapeError("vertices", fmt::format("vertices[{}] and [{}] coincide, both {}", i, j,
+                                               format(vertices[i])));
   }
   const Vec3 newell = newellVector(vertices, count);
   if (length(newell) <= kCollinearTolerance * size * size)
-    throw ShapeError(fmt::format("vertices are collinear (enclosed area {} for size {})",
+    throw ShapeError("vertices",
+                     fmt::format("vertices are collinear (enclosed area {} for size {})",
                                  0.5 * length(newell), size));
   const Vec3 n = normalize(newell);
   Vec3 centroid;
@@ -102,9 +115,9 @@ Normal3 requirePlanarLoop(const Point3* vertices, std::size_t count) {
   for (std::size_t i = 0; i < count; ++i) {
     const double offPlane = std::abs(dot(toVec(vertices[i]) - centroid, n));
     if (offPlane > kShapeTolerance * size)
-      throw ShapeError(fmt::format(
-          "vertices are not planar: vertices[{}] is {} away from the plane of the others (size {})",
-          i, offPlane, size));
+      throw ShapeError("vertices", fmt::format("vertices are not planar: vertices[{}] is {} away "
+                                               "from the plane of the others (size {})",
+                                               i, offPlane, size));
   }
   return Normal3(n);
 }
@@ -254,14 +267,15 @@ Normal3 nonCollinearNormal(const char* key, const Point3& a, const Point3& b, co
   const Point3 points[3] = {a, b, c};
   for (int i = 0; i < 3; ++i) {
     if (!isFinite(points[i]))
-      throw ShapeError(fmt::format("{}[{}] must be finite, got {}", key, i, format(points[i])));
+      throw ShapeError(parameterOf(key),
+                       fmt::format("{}[{}] must be finite, got {}", key, i, format(points[i])));
   }
   const Vec3 n = cross(b - a, c - a);
   const double longest =
       std::max({distanceSquared(a, b), distanceSquared(b, c), distanceSquared(c, a)});
   if (length(n) <= kCollinearTolerance * longest)
-    throw ShapeError(
-        fmt::format("{} are collinear: {}, {}, {}", key, format(a), format(b), format(c)));
+    throw ShapeError(parameterOf(key), fmt::format("{} are collinear: {}, {}, {}", key, format(a),
+                                                   format(b), format(c)));
   return Normal3(normalize(n));
 }
 
@@ -433,7 +447,8 @@ Normal3 Triangle::normalAt(const Point3&) const { return normal; }
 Polygon Polygon::make(std::vector<Point3> vertices) {
   const std::size_t count = vertices.size();
   if (count < 3)
-    throw ShapeError(fmt::format("vertices must hold at least 3 points, got {}", count));
+    throw ShapeError("vertices",
+                     fmt::format("vertices must hold at least 3 points, got {}", count));
   const Normal3 n = requirePlanarLoop(vertices.data(), count);
   // Convex and simple: every corner turns the same way about the normal (a straight corner, a
   // vertex in the middle of an edge, is allowed), and the turns add up to one full revolution —
@@ -443,15 +458,17 @@ Polygon Polygon::make(std::vector<Point3> vertices) {
     const Turn turn = turnAt(vertices.data(), count, i, n);
     if (turn.sine < -kShapeTolerance)
       throw ShapeError(
+          "vertices",
           fmt::format("vertices are not convex: the corner at vertices[{}] {} turns the other way",
                       i, format(vertices[i])));
     if (std::abs(turn.sine) <= kShapeTolerance && turn.cosine < 0)
       throw ShapeError(
-          fmt::format("vertices fold back at vertices[{}] {}", i, format(vertices[i])));
+          "vertices", fmt::format("vertices fold back at vertices[{}] {}", i, format(vertices[i])));
     totalTurn += std::atan2(turn.sine, turn.cosine);
   }
   if (totalTurn > 3 * std::numbers::pi)
-    throw ShapeError(fmt::format("vertices are self-intersecting: the edges wind around {} times",
+    throw ShapeError("vertices",
+                     fmt::format("vertices are self-intersecting: the edges wind around {} times",
                                  std::lround(totalTurn / (2 * std::numbers::pi))));
   return Polygon{std::move(vertices), n};
 }
@@ -496,9 +513,10 @@ Rectangle Rectangle::make(const Point3& corner, const Vec3& edge0, const Vec3& e
   const double len1 = length(edge1);
   const double cosine = dot(edge0, edge1) / (len0 * len1);
   if (std::abs(cosine) > kShapeTolerance)
-    throw ShapeError(fmt::format(
-        "edges must be perpendicular, got {} and {} at {:.6g} degrees", format(edge0),
-        format(edge1), std::acos(std::clamp(cosine, -1.0, 1.0)) * 180 / std::numbers::pi));
+    throw ShapeError(
+        "edges", fmt::format("edges must be perpendicular, got {} and {} at {:.6g} degrees",
+                             format(edge0), format(edge1),
+                             std::acos(std::clamp(cosine, -1.0, 1.0)) * 180 / std::numbers::pi));
   return Rectangle{corner, edge0, edge1, Normal3(normalize(cross(edge0, edge1)))};
 }
 
@@ -541,7 +559,8 @@ Quadrangle Quadrangle::make(const Point3& v0, const Point3& v1, const Point3& v2
   for (std::size_t i = 0; i < 4; ++i) {
     const Turn turn = turnAt(v, 4, i, n);
     if (std::abs(turn.sine) <= kShapeTolerance && turn.cosine < 0)
-      throw ShapeError(fmt::format("vertices fold back at vertices[{}] {}", i, format(v[i])));
+      throw ShapeError("vertices",
+                       fmt::format("vertices fold back at vertices[{}] {}", i, format(v[i])));
     if (turn.sine < -kShapeTolerance) ++reflexCount;
     if (turn.sine < smallestTurn) {
       smallestTurn = turn.sine;
@@ -549,8 +568,8 @@ Quadrangle Quadrangle::make(const Point3& v0, const Point3& v1, const Point3& v2
     }
   }
   if (reflexCount > 1)
-    throw ShapeError(fmt::format("vertices are self-intersecting: {}, {}, {}, {}", format(v0),
-                                 format(v1), format(v2), format(v3)));
+    throw ShapeError("vertices", fmt::format("vertices are self-intersecting: {}, {}, {}, {}",
+                                             format(v0), format(v1), format(v2), format(v3)));
   // The diagonal from the reflex corner (or, when convex, from the flattest one, which may be a
   // straight 180° corner) lies inside and leaves no degenerate half.
   const std::size_t k = diagonalFrom;
@@ -559,8 +578,8 @@ Quadrangle Quadrangle::make(const Point3& v0, const Point3& v1, const Point3& v2
     Triangle::make(corners[0], corners[1], corners[2]);
     Triangle::make(corners[0], corners[2], corners[3]);
   } catch (const ShapeError&) {
-    throw ShapeError(fmt::format("vertices are degenerate: {}, {}, {}, {}", format(v0), format(v1),
-                                 format(v2), format(v3)));
+    throw ShapeError("vertices", fmt::format("vertices are degenerate: {}, {}, {}, {}", format(v0),
+                                             format(v1), format(v2), format(v3)));
   }
   return Quadrangle{corners, n};
 }
@@ -810,8 +829,8 @@ Box Box::make(const Point3& lo, const Point3& hi) {
   requireFinite("min", lo);
   requireFinite("max", hi);
   if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
-    throw ShapeError(fmt::format("min must be < max on every axis, got min {} and max {}",
-                                 format(lo), format(hi)));
+    throw ShapeError("min", fmt::format("min must be < max on every axis, got min {} and max {}",
+                                        format(lo), format(hi)));
   return Box{lo, hi};
 }
 
@@ -904,15 +923,17 @@ void requireInvertibleAffine(const Transform& transform) {
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
       if (!std::isfinite(m[i][j]) || !std::isfinite(inv[i][j]))
-        throw ShapeError("transform must be finite, got a non-finite matrix entry");
+        throw ShapeError("transform", "transform must be finite, got a non-finite matrix entry");
   if (m[3][0] != 0 || m[3][1] != 0 || m[3][2] != 0 || m[3][3] != 1)
-    throw ShapeError(fmt::format("transform must be affine, got bottom row [{}, {}, {}, {}]",
+    throw ShapeError("transform",
+                     fmt::format("transform must be affine, got bottom row [{}, {}, {}, {}]",
                                  m[3][0], m[3][1], m[3][2], m[3][3]));
   const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
                      m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
                      m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
   if (det == 0 || !std::isfinite(det))
-    throw ShapeError(fmt::format("transform must be invertible, got determinant {}", det));
+    throw ShapeError("transform",
+                     fmt::format("transform must be invertible, got determinant {}", det));
 }
 
 // Error bound of worldFromObject(p) for an object-space point p with error bound e (pbrt-v4

@@ -3,6 +3,8 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace glint {
@@ -24,6 +26,39 @@ struct Diagnostic {
   // "FILE:LINE:COL: message" for errors, "FILE:LINE:COL: warning: message" for warnings;
   // "FILE: message" when there is no line.
   std::string format() const;
+};
+
+// Text from a file as messages quote it: control characters and terminal escape codes written as
+// \n, \t, \x1b, ... (never printed raw), and at most kMaxQuoted characters (a longer text ends
+// in "..."), never cutting a UTF-8 sequence. shortenForMessage gives it bare, quoteForMessage in
+// single quotes.
+inline constexpr std::size_t kMaxQuoted = 40;
+std::string shortenForMessage(std::string_view text);
+// The same escaping without the length limit: file and material names, shown whole.
+std::string escapeForMessage(std::string_view text);
+std::string quoteForMessage(std::string_view text);
+
+// Errors and warnings as they are found, in any order (the loader sorts them by place).
+class Diagnostics {
+ public:
+  void error(SourceLocation where, std::string message) {
+    list_.push_back({Diagnostic::Severity::Error, std::move(where), std::move(message)});
+    ++errors_;
+  }
+  void warning(SourceLocation where, std::string message) {
+    list_.push_back({Diagnostic::Severity::Warning, std::move(where), std::move(message)});
+  }
+  std::size_t errorCount() const { return errors_; }
+  bool hasErrors() const { return errors_ > 0; }
+  const std::vector<Diagnostic>& all() const { return list_; }
+  std::vector<Diagnostic> take() {
+    errors_ = 0;
+    return std::move(list_);
+  }
+
+ private:
+  std::vector<Diagnostic> list_;
+  std::size_t errors_ = 0;
 };
 
 // Thrown by the scene loader with every error found in a file (at most kMaxReportedErrors).

@@ -39,6 +39,9 @@ inline std::size_t editDistance(std::string_view a, std::string_view b) {
 // of the longer word's letters differ, and at most 3), else empty.
 template <class Names>
 std::string closestName(std::string_view word, const Names& candidates) {
+  // No key is this long: a suggestion would only cost time (the distance is quadratic).
+  constexpr std::size_t kLongestWord = 64;
+  if (word.size() > kLongestWord) return {};
   std::string best;
   std::size_t bestDistance = 0;
   for (const auto& candidate : candidates) {

@@ -1,0 +1,21 @@
+// The material factory: a material's keys (DESIGN.md §3, §5) → Material, for named materials
+// (`materials:`) and inline ones (an object's `material: {...}`) alike.
+#pragma once
+
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "glint/readers/parameter_dictionary.h"
+#include "glint/scene/material.h"
+
+namespace glint {
+
+// The keys of a material, in the order messages list them.
+const std::vector<std::string_view>& materialKeys();
+
+// Declares and reads the material keys of `params`; nullopt when a value is out of range or of
+// the wrong type (reported at the value). Absent keys keep Material's defaults.
+std::optional<Material> readMaterial(ParameterDictionary& params);
+
+}  // namespace glint

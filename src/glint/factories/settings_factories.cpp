@@ -1,0 +1,305 @@
+#include "glint/factories/settings_factories.h"
+
+#include <limits>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "glint/readers/spelling.h"
+#include "glint/scene/camera.h"
+
+namespace glint {
+namespace {
+
+constexpr Presence kRequired = Presence::Required;
+
+// up is refused when the sine of its angle to the view direction is at most this; the camera uses
+// the same bound (scene/camera.cpp), so a scene that builds here never fails there.
+constexpr double kParallelSine = 1e-6;
+
+ValueReader readerOf(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
+  return ValueReader(scene.fileOf(e).source(), ctx.sink);
+}
+
+// image.adaptive, after image.samples: max_samples may not be below the fixed count, and the
+// worst case (every pixel taking max_samples) must pass the same camera-ray limit.
+void buildAdaptive(ParameterDictionary& adaptiveParams, bool checkSize, BuildContext& ctx) {
+  ParameterDictionary& p = adaptiveParams;
+  p.declare({"max_samples", "threshold"});
+  AdaptiveSampling adaptive;  // the defaults
+  const auto maxSamples = p.integer("max_samples");
+  bool maxOk = true;
+  if (maxSamples) {
+    maxOk = checkInRange(p, *maxSamples, 1, kMaxSamplesPerPixel, "image.adaptive.max_samples");
+    if (maxOk) adaptive.maxSamples = static_cast<int>(maxSamples->value);
+  }
+  if (const auto threshold = readPositive(p, "threshold")) adaptive.threshold = *threshold;
+  ImageSettings& image = ctx.parts.image;
+  if (maxOk && adaptive.maxSamples < image.samples) {
+    if (maxSamples) {
+      p.error(maxSamples->where,
+              fmt::format("image.adaptive.max_samples must be >= image.samples ({}), got {}",
+                          image.samples, adaptive.maxSamples));
+    } else {
+      p.error(p.place(), fmt::format("image.adaptive.max_samples (default {}) must be >= "
+                                     "image.samples ({}); give a larger max_samples",
+                                     adaptive.maxSamples, image.samples));
+    }
+    maxOk = false;
+  }
+  if (maxOk && checkSize && adaptive.maxSamples > image.samples) {
+    if (auto problem = checkRenderSize(image.width, image.height, adaptive.maxSamples,
+                                       ctx.options.imageMemoryBudget)) {
+      p.error(maxSamples ? maxSamples->where : p.place(),
+              "image.adaptive.max_samples: " + *problem);
+    }
+  }
+  image.adaptive = adaptive;
+  p.finish();
+}
+
+}  // namespace
+
+void buildImage(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
+  const ValueReader reader = readerOf(scene, e, ctx);
+  auto params = entityParameters(reader, e.value, e.place, "a mapping with width and height",
+                                 {"in image", "image", "image"});
+  if (!params) return;
+  ParameterDictionary& p = *params;
+  p.declare({"width", "height", "samples", "encoding", "grid", "adaptive"});
+  ImageSettings& image = ctx.parts.image;
+  const std::size_t errorsBefore = p.errors();
+  // First: the encoding decides how every "#rrggbb" colour decodes.
+  if (const auto name = p.text("encoding")) {
+    if (name->value == "srgb") {
+      ctx.encoding = Encoding::Srgb;
+    } else if (name->value == "linear") {
+      ctx.encoding = Encoding::Linear;
+    } else {
+      p.error(name->where,
+              fmt::format(
+                  "image.encoding must be srgb or linear, got {}{}", quoteForMessage(name->value),
+                  didYouMean(name->value, std::vector<std::string_view>{"srgb", "linear"})));
+    }
+  }
+  image.encoding = ctx.encoding;
+  bool sizeOk = true;
+  if (const auto w = readIntegerInRange(p, "width", 1, kMaxImageSide, kRequired)) {
+    image.width = static_cast<int>(*w);
+  } else {
+    sizeOk = false;
+  }
+  if (const auto h = readIntegerInRange(p, "height", 1, kMaxImageSide, kRequired)) {
+    image.height = static_cast<int>(*h);
+  } else {
+    sizeOk = false;
+  }
+  if (const auto samples = p.integer("samples")) {
+    if (checkInRange(p, *samples, 1, kMaxSamplesPerPixel, "image.samples")) {
+      image.samples = static_cast<int>(samples->value);
+    } else {
+      sizeOk = false;
+    }
+  }
+  if (auto gridParams = p.mapping("grid", "a mapping {interval, color}",
+                                  {"in image.grid", "image.grid", "image.grid"})) {
+    gridParams->declare({"interval", "color"});
+    GridOverlay grid;
+    if (const auto interval =
+            readIntegerInRange(*gridParams, "interval", 1, std::numeric_limits<int>::max())) {
+      grid.interval = static_cast<int>(*interval);
+    }
+    if (const auto c = readColor(*gridParams, "color", ctx.encoding)) grid.color = *c;
+    gridParams->finish();
+    image.grid = grid;
+  }
+  ctx.sceneImage = {image.width, image.height};
+  // The caller's --width/--height/--samples replace the scene's values before anything is
+  // estimated from them (the film, the meshes' share of the budget); the caller then checks the
+  // image it asked for against the limits, naming its options.
+  const SceneOverrides& overrides = ctx.options.overrides;
+  const bool overridden = overrides.width || overrides.height || overrides.samples;
+  if (sizeOk && !overridden) {
+    // Refused here, before the renderer allocates anything for it.
+    if (auto problem = checkImageSettings(image, ctx.options.imageMemoryBudget)) {
+      p.error(p.place(), "image: " + *problem);
+      sizeOk = false;
+    }
+  }
+  if (auto adaptive = p.mapping("adaptive", "a mapping {max_samples, threshold}",
+                                {"in image.adaptive", "image.adaptive", "image.adaptive"})) {
+    buildAdaptive(*adaptive, sizeOk && !overridden, ctx);
+  }
+  p.finish();
+  ctx.imageOk = sizeOk && p.errors() == errorsBefore;
+  if (ctx.imageOk && overridden) applyImageOverrides(image, overrides);
+}
+
+void buildRender(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
+  RenderSettings& render = ctx.parts.render;
+  if (ctx.options.overrides.seed) render.seed = *ctx.options.overrides.seed;
+  const ValueReader reader = readerOf(scene, e, ctx);
+  auto params = entityParameters(reader, e.value, e.place, "a mapping of render settings",
+                                 {"in render", "render", "render"});
+  if (!params) return;
+  ParameterDictionary& p = *params;
+  p.declare({"max_depth", "min_weight", "blur_samples", "seed"});
+  if (const auto v = readIntegerInRange(p, "max_depth", 1, kMaxRenderDepth)) {
+    render.maxDepth = static_cast<int>(*v);
+  }
+  if (const auto v = readNonNegative(p, "min_weight")) render.minWeight = *v;
+  if (const auto v = readIntegerInRange(p, "blur_samples", 1, kMaxBlurSamples)) {
+    render.blurSamples = static_cast<int>(*v);
+  }
+  if (const auto v = p.unsignedInteger("seed")) render.seed = v->value;
+  if (ctx.options.overrides.seed) render.seed = *ctx.options.overrides.seed;
+  p.finish();
+}
+
+void buildAmbient(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
+  const ValueReader reader = readerOf(scene, e, ctx);
+  auto params = entityParameters(reader, e.value, e.place, "a mapping {color, intensity}",
+                                 {"in ambient", "ambient", "ambient"});
+  if (!params) return;
+  ParameterDictionary& p = *params;
+  p.declare({"color", "intensity"});
+  Color color(1);
+  double intensity = 1;
+  if (const auto c = readColor(p, "color", ctx.encoding)) color = *c;
+  if (const auto v = readNonNegative(p, "intensity")) intensity = *v;
+  ctx.parts.ambient = color * intensity;
+  p.finish();
+}
+
+void buildBackground(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
+  const ValueReader reader = readerOf(scene, e, ctx);
+  // A single colour: read as the one value of a dictionary-less entity.
+  const ValuePath path{nullptr, "background", {}, ValuePath::kNoIndex};
+  const std::size_t before = ctx.sink.errorCount();
+  const auto value = reader.color(e.value, e.place, path);
+  if (!value || ctx.sink.errorCount() != before) return;
+  ParameterDictionary none(reader, kNoValue, {"", "background", "background"});
+  if (const auto c = decodeColor(none, {*value, e.place}, "background", ctx.encoding)) {
+    ctx.parts.background = *c;
+  }
+}
+
+void buildCamera(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
+  const ValueReader reader = readerOf(scene, e, ctx);
+  auto params =
+      entityParameters(reader, e.value, e.place,
+                       "a mapping with position, direction or look_at, and view_plane or fov",
+                       {"in camera", "camera", "camera"});
+  if (!params) return;
+  ParameterDictionary& p = *params;
+  p.declare({"position", "direction", "look_at", "up", "view_plane", "fov", "aperture",
+             "focus_distance"});
+  CameraSpec& spec = ctx.parts.camera;
+
+  // The either/or choices, at the later key when both are given.
+  for (const auto& [a, b] : {std::pair{"direction", "look_at"}, std::pair{"view_plane", "fov"}}) {
+    if (const ValueId later = p.laterKey(a, b); later != kNoValue) {
+      p.error(later, fmt::format("camera has both '{}' and '{}'; give only one of them", a, b));
+    } else if (!p.has(a) && !p.has(b)) {
+      p.error(p.place(), fmt::format("camera needs '{}' or '{}'", a, b));
+    }
+  }
+
+  const auto position = p.point3("position", kRequired);
+  if (position) spec.position = position->value;
+  std::optional<Vec3> direction;
+  ValueId directionWhere = p.place();
+  const auto lookAt = p.point3("look_at");
+  if (p.has("direction")) {
+    direction = readDirection(p, "direction");
+    directionWhere = p.find("direction")->where;
+  } else if (lookAt) {
+    directionWhere = lookAt->where;
+    if (position) {
+      direction = unitVector(lookAt->value - position->value);
+      if (!direction) {
+        p.error(lookAt->where,
+                fmt::format("camera.look_at must differ from camera.position, got {} for both",
+                            show(toVec(lookAt->value))));
+      }
+    }
+  }
+  const auto upWritten = p.vec3("up");
+  std::optional<Vec3> up = Vec3{0, 1, 0};
+  if (upWritten) {
+    up = unitVector(upWritten->value);
+    if (!up) {
+      p.error(upWritten->where,
+              fmt::format("camera.up must be non-zero, got {}", show(upWritten->value)));
+    }
+  } else if (p.has("up")) {
+    up.reset();  // a wrong type, already reported
+  }
+  if (direction && up && length(cross(*direction, *up)) <= kParallelSine) {
+    p.error(
+        upWritten ? upWritten->where : directionWhere,
+        fmt::format("camera.up {} is parallel to the view direction {}; choose an up that "
+                    "points away from it",
+                    upWritten ? show(upWritten->value) : "(default [0, 1, 0])", show(*direction)));
+  }
+  if (direction) spec.direction = *direction;
+  if (up) spec.up = *up;
+
+  if (auto plane = p.mapping("view_plane", "a mapping {width, height, distance}",
+                             {"in camera.view_plane", "camera.view_plane", "camera.view_plane"})) {
+    plane->declare({"width", "height", "distance"});
+    if (const auto w = readPositive(*plane, "width", kRequired)) spec.viewPlaneWidth = *w;
+    if (const auto h = readPositive(*plane, "height", kRequired)) spec.viewPlaneHeight = *h;
+    if (const auto d = readPositive(*plane, "distance", kRequired)) spec.viewPlaneDistance = *d;
+    plane->finish();
+    // Square pixels also when the caller changed the image's aspect (--width and --height): the
+    // view plane widens or narrows with the image, its height kept, as a fov camera's does.
+    const ImageSize& asked = ctx.sceneImage;
+    const ImageSettings& image = ctx.parts.image;
+    if (ctx.imageOk && spec.viewPlaneWidth > 0 &&
+        static_cast<std::int64_t>(image.width) * asked.height !=
+            static_cast<std::int64_t>(image.height) * asked.width) {
+      spec.viewPlaneWidth *= (static_cast<double>(image.width) / image.height) /
+                             (static_cast<double>(asked.width) / asked.height);
+    }
+  }
+  // With both a view plane and a fov (an error above) the view plane is the one checked.
+  if (const auto fov = p.number("fov"); fov && !p.has("view_plane")) {
+    if (fov->value > 0 && fov->value < 180) {
+      spec.fovDegrees = fov->value;
+    } else {
+      p.error(fov->where,
+              fmt::format("camera.fov must be in (0, 180) degrees, got {}", show(fov->value)));
+    }
+  }
+  const auto aperture = p.number("aperture");
+  if (aperture && checkNonNegative(p, *aperture, "camera.aperture"))
+    spec.aperture = aperture->value;
+  const auto focus = p.number("focus_distance");
+  if (focus && checkPositive(p, *focus, "camera.focus_distance")) spec.focusDistance = focus->value;
+  if (aperture && aperture->value > 0 && !focus) {
+    // The point looked at is in focus unless focus_distance says otherwise; it lies on the view
+    // axis, so its distance is the distance along vTo.
+    if (lookAt && position && direction) {
+      spec.focusDistance = length(lookAt->value - position->value);
+    } else if (!lookAt) {
+      p.error(aperture->where,
+              "camera.focus_distance is required when camera.aperture > 0 and the camera has no "
+              "look_at (with look_at it defaults to the distance to that point)");
+    }
+  }
+  spec.imageWidth = ctx.parts.image.width;
+  spec.imageHeight = ctx.parts.image.height;
+  p.finish();
+
+  // The camera's own checks as a last guard (they should agree with the ones above).
+  if (p.errors() == 0 && ctx.imageOk) {
+    try {
+      const Camera camera(spec);
+    } catch (const std::invalid_argument& error) {  // CameraError
+      p.error(p.place(), fmt::format("camera: {}", error.what()));
+    }
+  }
+}
+
+}  // namespace glint

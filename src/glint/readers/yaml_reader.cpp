@@ -1,0 +1,472 @@
+#include "glint/readers/yaml_reader.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+#include <yaml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <system_error>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "glint/core/cancel.h"
+#include "glint/readers/diagnostics.h"
+
+namespace glint::yaml {
+namespace {
+
+// Events between polls of the cancel flag: about a millisecond of parsing.
+constexpr std::size_t kEventsPerPoll = 4096;
+// Bytes libyaml asks for at a time from a file.
+constexpr std::size_t kReadBlock = std::size_t{1} << 16;
+
+constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
+constexpr std::uint64_t kFnvPrime = 1099511628211ull;
+
+std::uint64_t saturatingAdd(std::uint64_t a, std::uint64_t b) {
+  return a > UINT64_MAX - b ? UINT64_MAX : a + b;
+}
+
+TextPosition positionOf(const yaml_mark_t& mark) {
+  return {static_cast<std::uint32_t>(std::min<std::size_t>(mark.index, ValueTree::kMaxOffset)),
+          static_cast<std::uint32_t>(mark.line + 1), static_cast<std::uint32_t>(mark.column + 1)};
+}
+
+// Where the text is read from: in memory, or a file descriptor in blocks. Keeps the running hash
+// and can give back one line of the text for error messages.
+class Source {
+ public:
+  explicit Source(std::string_view text) : text_(text) {}
+  Source(int fd, std::uint64_t maxBytes) : fd_(fd), maxBytes_(maxBytes) {}
+
+  bool inMemory() const { return fd_ < 0; }
+  std::string_view text() const { return text_; }
+  std::uint64_t bytesRead() const { return bytesRead_; }
+  std::uint64_t hash() const { return hash_; }
+  bool tooLarge() const { return tooLarge_; }
+  int readErrno() const { return readErrno_; }
+  const std::atomic<bool>* cancel = nullptr;
+  bool cancelled = false;
+
+  void hashBytes(const unsigned char* data, std::size_t size) {
+    for (std::size_t i = 0; i < size; ++i) hash_ = (hash_ ^ data[i]) * kFnvPrime;
+    bytesRead_ += size;
+  }
+
+  // libyaml's read handler: fills buffer with up to `size` bytes; 0 = error.
+  static int readHandler(void* data, unsigned char* buffer, std::size_t size,
+                         std::size_t* sizeRead) {
+    auto* self = static_cast<Source*>(data);
+    *sizeRead = 0;
+    if (isCancelled(self->cancel)) {
+      self->cancelled = true;
+      return 0;  // an exception must not cross libyaml's C frames
+    }
+    for (;;) {
+      const ssize_t n = ::read(self->fd_, buffer, std::min(size, kReadBlock));
+      if (n < 0 && errno == EINTR) {
+        if (isCancelled(self->cancel)) {
+          self->cancelled = true;
+          return 0;
+        }
+        continue;
+      }
+      if (n < 0) {
+        self->readErrno_ = errno;
+        return 0;
+      }
+      self->hashBytes(buffer, static_cast<std::size_t>(n));
+      if (self->bytesRead_ > self->maxBytes_) {
+        self->tooLarge_ = true;
+        return 0;
+      }
+      *sizeRead = static_cast<std::size_t>(n);
+      return 1;
+    }
+  }
+
+  // The 1-based line `line` of the text without its line break (empty when out of range); for a
+  // file, read again from the start (only on an error).
+  std::string line(std::uint32_t line) const {
+    if (inMemory()) return std::string(lineOf(text_, line));
+    std::string content;
+    char buffer[1 << 14];
+    off_t offset = 0;
+    std::uint32_t current = 1;
+    for (;;) {
+      const ssize_t n = ::pread(fd_, buffer, sizeof buffer, offset);
+      if (n <= 0) break;
+      offset += n;
+      for (ssize_t i = 0; i < n; ++i) {
+        if (buffer[i] == '\n') {
+          if (current == line) return content;
+          ++current;
+          continue;
+        }
+        if (current == line && content.size() < 4096) content.push_back(buffer[i]);
+      }
+      if (offset > static_cast<off_t>(maxBytes_)) break;
+    }
+    return current == line ? content : std::string();
+  }
+
+  // Line and column (1-based, in characters) of a byte offset of the text.
+  TextPosition positionOfByte(std::uint64_t offset) const {
+    TextPosition p{0, 1, 1};
+    const auto advance = [&](unsigned char c) {
+      if (c == '\n') {
+        ++p.line;
+        p.column = 1;
+      } else if ((c & 0xC0) != 0x80) {
+        ++p.column;
+      }
+      if ((c & 0xC0) != 0x80) ++p.offset;
+    };
+    if (inMemory()) {
+      for (std::uint64_t i = 0; i < offset && i < text_.size(); ++i) {
+        advance(static_cast<unsigned char>(text_[i]));
+      }
+      return p;
+    }
+    char buffer[1 << 14];
+    std::uint64_t done = 0;
+    while (done < offset) {
+      const ssize_t n = ::pread(fd_, buffer, std::min<std::uint64_t>(sizeof buffer, offset - done),
+                                static_cast<off_t>(done));
+      if (n <= 0) break;
+      for (ssize_t i = 0; i < n; ++i) advance(static_cast<unsigned char>(buffer[i]));
+      done += static_cast<std::uint64_t>(n);
+    }
+    return p;
+  }
+
+  static std::string_view lineOf(std::string_view text, std::uint32_t line) {
+    std::size_t begin = 0;
+    for (std::uint32_t l = 1; l < line; ++l) {
+      begin = text.find('\n', begin);
+      if (begin == std::string_view::npos) return {};
+      ++begin;
+    }
+    const std::size_t end = text.find('\n', begin);
+    return text.substr(begin, end == std::string_view::npos ? std::string_view::npos : end - begin);
+  }
+
+ private:
+  std::string_view text_;
+  int fd_ = -1;
+  std::uint64_t maxBytes_ = 0;
+  std::uint64_t bytesRead_ = 0;
+  std::uint64_t hash_ = kFnvOffset;
+  bool tooLarge_ = false;
+  int readErrno_ = 0;
+};
+
+// libyaml's syntax problems in plain words; `at` is the character at the problem's place.
+std::string plainProblem(std::string_view problem, std::string_view at) {
+  const std::string quoted = at.empty() ? std::string("end of file") : "'" + std::string(at) + "'";
+  if (problem == "did not find expected ',' or ']'") {
+    return "a '[' is not closed with ']' (or a ',' is missing between its items)";
+  }
+  if (problem == "did not find expected ',' or '}'") {
+    return "a '{' is not closed with '}' (or a ',' is missing between its entries)";
+  }
+  if (problem == "mapping values are not allowed in this context") {
+    return "unexpected ':' here (check the indentation, or quote the text)";
+  }
+  if (problem == "block sequence entries are not allowed in this context") {
+    return "unexpected '-' list item here (check the indentation)";
+  }
+  if (problem == "did not find expected '-' indicator") {
+    return "unexpected " + quoted + " in a list (check the indentation)";
+  }
+  if (problem == "did not find expected key") {
+    return "unexpected " + quoted + " in a mapping (check the indentation)";
+  }
+  if (problem == "could not find expected ':'") return "a key is not followed by ':'";
+  if (problem == "found unexpected end of stream") {
+    return "the file ends inside a quoted text (missing closing quote?)";
+  }
+  if (problem == "found unknown escape character") {
+    return "unknown escape sequence in quoted text: " + std::string(at);  // "\\q"
+  }
+  if (problem.find("tab character") != std::string_view::npos) {
+    return "tabs are not allowed in indentation; use spaces";
+  }
+  if (problem == "did not find expected node content" ||
+      problem == "did not find expected <document start>" ||
+      problem == "found character that cannot start any token") {
+    return "unexpected " + quoted + " here";
+  }
+  return std::string(problem);
+}
+
+// The UTF-8 character starting at column `column` (1-based, in characters) of `line`.
+std::string characterAt(std::string_view line, std::uint32_t column) {
+  std::uint32_t current = 1;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const auto c = static_cast<unsigned char>(line[i]);
+    if ((c & 0xC0) == 0x80) continue;
+    if (current == column) {
+      std::size_t end = i + 1;
+      while (end < line.size() && (static_cast<unsigned char>(line[end]) & 0xC0) == 0x80) ++end;
+      return shortenForMessage(line.substr(i, end - i));
+    }
+    ++current;
+  }
+  return {};
+}
+
+class Reader {
+ public:
+  Reader(Source& source, const Limits& limits, const std::atomic<bool>* cancel)
+      : source_(source), limits_(limits), cancel_(cancel) {
+    source_.cancel = cancel;
+  }
+
+  Document run(std::uint64_t expectedBytes) {
+    doc_.values.reserveForText(expectedBytes);
+    yaml_parser_t parser;
+    if (yaml_parser_initialize(&parser) == 0) throw std::bad_alloc();
+    struct Guard {
+      yaml_parser_t* parser;
+      ~Guard() { yaml_parser_delete(parser); }
+    } guard{&parser};
+    if (source_.inMemory()) {
+      const std::string_view text = source_.text();
+      yaml_parser_set_input_string(&parser, reinterpret_cast<const unsigned char*>(text.data()),
+                                   text.size());
+      source_.hashBytes(reinterpret_cast<const unsigned char*>(text.data()), text.size());
+    } else {
+      yaml_parser_set_input(&parser, &Source::readHandler, &source_);
+    }
+    yaml_parser_set_encoding(&parser, YAML_UTF8_ENCODING);
+
+    std::size_t events = 0;
+    bool done = false;
+    while (!done) {
+      if (++events % kEventsPerPoll == 0) throwIfCancelled(cancel_);
+      yaml_event_t event;
+      if (yaml_parser_parse(&parser, &event) == 0) fail(parser);
+      struct EventGuard {
+        yaml_event_t* event;
+        ~EventGuard() { yaml_event_delete(event); }
+      } eventGuard{&event};
+      done = handle(event);
+    }
+    doc_.root = doc_.values.root();
+    doc_.bytesRead = source_.bytesRead();
+    doc_.fnv1a = source_.hash();
+    return std::move(doc_);
+  }
+
+ private:
+  // Returns true when reading can stop: the end of the stream, or the start of a second document.
+  bool handle(const yaml_event_t& e) {
+    switch (e.type) {
+      case YAML_STREAM_END_EVENT:
+        return true;
+      case YAML_DOCUMENT_START_EVENT:
+        if (++documents_ == 2) {
+          doc_.secondDocument = positionOf(e.start_mark);
+          return true;
+        }
+        return false;
+      case YAML_SCALAR_EVENT: {
+        const auto* text = reinterpret_cast<const char*>(e.data.scalar.value);
+        const std::string_view value(text, e.data.scalar.length);
+        // The core schema's nulls, as plain (unquoted) scalars only: "~", "null", empty.
+        const bool isNull = e.data.scalar.style == YAML_PLAIN_SCALAR_STYLE &&
+                            (value.empty() || value == "~" || value == "null" || value == "Null" ||
+                             value == "NULL");
+        countValue(e.start_mark);
+        const ValueId id = isNull ? doc_.values.addNull(positionOf(e.start_mark))
+                                  : doc_.values.addScalar(value, positionOf(e.start_mark));
+        added(id, e.data.scalar.anchor);
+        return false;
+      }
+      case YAML_SEQUENCE_START_EVENT:
+        open(ValueKind::List, e.start_mark, e.data.sequence_start.anchor);
+        return false;
+      case YAML_MAPPING_START_EVENT:
+        open(ValueKind::Map, e.start_mark, e.data.mapping_start.anchor);
+        return false;
+      case YAML_SEQUENCE_END_EVENT:
+      case YAML_MAPPING_END_EVENT:
+        close();
+        return false;
+      case YAML_ALIAS_EVENT:
+        alias(e);
+        return false;
+      default:
+        return false;
+    }
+  }
+
+  void countValue(const yaml_mark_t& mark) {
+    if (doc_.values.valueCount() >= limits_.maxValues) {
+      throw SyntaxError(positionOf(mark),
+                        fmt::format("the document holds more than {} values (scalars, lists and "
+                                    "mappings); a scene file describes a scene, and large "
+                                    "geometry belongs in mesh files",
+                                    limits_.maxValues),
+                        SyntaxError::Kind::Refused);
+    }
+  }
+
+  void added(ValueId id, const yaml_char_t* anchor) {
+    weight_.push_back(1);
+    open_.push_back(false);
+    if (anchor != nullptr) anchors_[reinterpret_cast<const char*>(anchor)] = id;
+  }
+
+  void open(ValueKind kind, const yaml_mark_t& mark, const yaml_char_t* anchor) {
+    if (doc_.values.openCollections() >= limits_.maxDepth) {
+      throw SyntaxError(positionOf(mark),
+                        fmt::format("syntax error: lists or mappings are nested too deeply (more "
+                                    "than {} levels)",
+                                    limits_.maxDepth),
+                        SyntaxError::Kind::TooDeep);
+    }
+    countValue(mark);
+    const ValueId id = doc_.values.open(kind, positionOf(mark));
+    added(id, anchor);
+    open_[id] = true;
+    stack_.push_back(id);
+  }
+
+  // A closed collection's weight: itself plus its children's (aliased subtrees included).
+  void close() {
+    const ValueId id = stack_.back();
+    stack_.pop_back();
+    doc_.values.close();
+    open_[id] = false;
+    std::uint64_t weight = 1;
+    const ValueTree& t = doc_.values;
+    const std::size_t n = t.kind(id) == ValueKind::Map ? 2 * t.size(id) : t.size(id);
+    for (std::size_t i = 0; i < n; ++i) {
+      const ValueId child = t.kind(id) == ValueKind::Map
+                                ? (i % 2 == 0 ? t.key(id, i / 2) : t.value(id, i / 2))
+                                : t.item(id, i);
+      weight = saturatingAdd(weight, weight_[child]);
+    }
+    weight_[id] = weight;
+  }
+
+  void alias(const yaml_event_t& e) {
+    const TextPosition where = positionOf(e.start_mark);
+    const auto* name = reinterpret_cast<const char*>(e.data.alias.anchor);
+    const auto it = anchors_.find(name);
+    if (it == anchors_.end()) {
+      throw SyntaxError(where,
+                        fmt::format("syntax error: an alias (*{}) refers to an undefined anchor",
+                                    shortenForMessage(name)),
+                        SyntaxError::Kind::Syntax);
+    }
+    const ValueId target = it->second;
+    if (open_[target]) {
+      // `&a [*a]`: the anchor's value would contain itself, and every walk of it never ends.
+      throw SyntaxError(where, "an alias (*name) refers to a list or mapping that contains it",
+                        SyntaxError::Kind::Refused);
+    }
+    aliasValues_ = saturatingAdd(aliasValues_, weight_[target]);
+    const std::uint64_t allowed =
+        std::max<std::uint64_t>(limits_.maxAliasValues, doc_.values.valueCount());
+    if (aliasValues_ > allowed) {
+      throw SyntaxError(
+          where,
+          fmt::format("the aliases (*name) up to here repeat {} nodes, more than the limit of {} "
+                      "(a YAML alias bomb?)",
+                      aliasValues_ == UINT64_MAX ? std::string("more than 10^19")
+                                                 : std::to_string(aliasValues_),
+                      allowed),
+          SyntaxError::Kind::Refused);
+    }
+    doc_.values.attach(target);
+  }
+
+  [[noreturn]] void fail(const yaml_parser_t& parser) {
+    if (source_.cancelled) throw Cancelled();
+    if (source_.tooLarge()) {
+      throw SyntaxError({}, "", SyntaxError::Kind::Refused);  // the caller words it
+    }
+    if (source_.readErrno() != 0) {
+      throw std::system_error(source_.readErrno(), std::generic_category());
+    }
+    if (parser.error == YAML_READER_ERROR) {
+      // Bytes that are not UTF-8 text: libyaml gives the byte offset, not the place.
+      const TextPosition where = source_.positionOfByte(parser.problem_offset);
+      const std::string problem = parser.problem != nullptr ? parser.problem : "";
+      const int value = parser.problem_value;
+      std::string message;
+      if (problem == "control characters are not allowed") {
+        message =
+            fmt::format("the file holds a control character ({}) here; a scene file is UTF-8 text",
+                        value == 0 ? std::string("a NUL byte") : fmt::format("U+{:04X}", value));
+      } else if (problem.find("UTF-16") != std::string::npos ||
+                 problem.find("surrogate") != std::string::npos) {
+        message = "the file is not valid UTF-16 text here (" + problem + ")";
+      } else {
+        message = fmt::format("the file is not UTF-8 text here (byte 0x{:02X}: {})",
+                              static_cast<unsigned>(value) & 0xFF, problem);
+      }
+      throw SyntaxError(where, message, SyntaxError::Kind::Encoding);
+    }
+    TextPosition where = positionOf(parser.problem_mark);
+    const std::string problem = parser.problem != nullptr ? parser.problem : "syntax error";
+    const std::string line = source_.line(where.line);
+    std::string at = characterAt(line, where.column);
+    // An escape sequence is shown whole: the backslash at the mark and the character after it.
+    if (problem == "found unknown escape character") at += characterAt(line, where.column + 1);
+    std::string message = "syntax error: " + plainProblem(problem, at);
+    // A tab in the indentation of this line or the previous one is the usual cause of a baffling
+    // syntax error; YAML forbids tabs there.
+    for (std::uint32_t l = where.line; l >= 1 && l + 1 >= where.line; --l) {
+      const std::string text = l == where.line ? line : source_.line(l);
+      const std::size_t indent = text.find_first_not_of(" \t");
+      if (text.substr(0, indent).find('\t') != std::string::npos) {
+        where = {0, l, 1};
+        message = "syntax error: tabs are not allowed in indentation; use spaces";
+        break;
+      }
+    }
+    throw SyntaxError(where, message, SyntaxError::Kind::Syntax);
+  }
+
+  Source& source_;
+  const Limits limits_;
+  const std::atomic<bool>* cancel_;
+  Document doc_;
+  int documents_ = 0;
+  std::vector<ValueId> stack_;
+  std::unordered_map<std::string, ValueId> anchors_;
+  // Per value: values of its subtree with aliases expanded (saturating), and whether it is open.
+  std::vector<std::uint64_t> weight_;
+  std::vector<bool> open_;
+  std::uint64_t aliasValues_ = 0;
+};
+
+}  // namespace
+
+Document read(std::string_view text, const Limits& limits, const std::atomic<bool>* cancel) {
+  Source source(text);
+  return Reader(source, limits, cancel).run(text.size());
+}
+
+Document readFile(int fd, std::uint64_t maxBytes, const Limits& limits,
+                  const std::atomic<bool>* cancel) {
+  Source source(fd, maxBytes);
+  struct stat info {};
+  const std::uint64_t size = ::fstat(fd, &info) == 0 && S_ISREG(info.st_mode)
+                                 ? static_cast<std::uint64_t>(info.st_size)
+                                 : 0;
+  return Reader(source, limits, cancel).run(std::min(size, maxBytes));
+}
+
+}  // namespace glint::yaml
