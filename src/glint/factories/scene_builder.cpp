@@ -52,7 +52,11 @@ class Builder {
         options_(options),
         parts_(result.parts),
         ctx_{options, sink_, result.parts, Encoding::Srgb, false, {}},
-        result_(result) {}
+        result_(result) {
+    for (const ObjectFactory& f : objectFactories()) objectTypes_.push_back(f.type);
+    for (const ObjectFactory& f : options_.extraObjectFactories) objectTypes_.push_back(f.type);
+    for (const LightFactory& f : lightFactories()) lightTypes_.push_back(f.type);
+  }
 
   void build() {
     const SourceFile& main = *d_.files.at(0);
@@ -165,19 +169,15 @@ class Builder {
 
   // --- objects --------------------------------------------------------------------------------
 
-  std::string objectTypeList() const {
-    std::vector<std::string_view> names;
-    for (const ObjectFactory& f : objectFactories()) names.push_back(f.type);
-    for (const ObjectFactory& f : options_.extraObjectFactories) names.push_back(f.type);
-    return fmt::format("{}", fmt::join(names, ", "));
-  }
-
   // The factory an entity's `type` names, or nullptr (reported).
   template <class Factory, class Find>
   const Factory* factoryOf(const ValueReader& reader, const Entity& e, std::string_view family,
                            const std::string& path, const std::vector<std::string_view>& names,
                            Find&& find) {
     const ValueTree& tree = reader.tree();
+    if (e.type != kNoValue && tree.isScalar(e.type)) {
+      if (const Factory* f = find(tree.scalar(e.type))) return f;
+    }
     const std::string list = fmt::format("{}", fmt::join(names, ", "));
     if (e.type == kNoValue) {
       reader.error(e.value,
@@ -198,7 +198,6 @@ class Builder {
                    "type");
       return nullptr;
     }
-    if (const Factory* f = find(type)) return f;
     reader.error(e.type, fmt::format("unknown {} type {}; expected one of: {}{}", family,
                                      quoteForMessage(type), list, didYouMean(type, names)));
     return nullptr;
@@ -226,11 +225,8 @@ class Builder {
                                         path, reader.describe(e.value)));
       return;
     }
-    std::vector<std::string_view> typeNames;
-    for (const ObjectFactory& f : objectFactories()) typeNames.push_back(f.type);
-    for (const ObjectFactory& f : options_.extraObjectFactories) typeNames.push_back(f.type);
     const ObjectFactory* factory = factoryOf<ObjectFactory>(
-        reader, e, "object", path, typeNames, [this](std::string_view type) {
+        reader, e, "object", path, objectTypes_, [this](std::string_view type) {
           return findObjectFactory(type, options_.extraObjectFactories);
         });
     if (factory == nullptr) {
@@ -361,10 +357,8 @@ class Builder {
                                         path, reader.describe(e.value)));
       return;
     }
-    std::vector<std::string_view> typeNames;
-    for (const LightFactory& f : lightFactories()) typeNames.push_back(f.type);
     const LightFactory* factory =
-        factoryOf<LightFactory>(reader, e, "light", path, typeNames,
+        factoryOf<LightFactory>(reader, e, "light", path, lightTypes_,
                                 [](std::string_view type) { return findLightFactory(type); });
     if (factory == nullptr) {
       ParameterDictionary(reader, e.value, {"in " + path, path, path}).finish();
@@ -479,6 +473,8 @@ class Builder {
   std::map<const MeshFile*, std::vector<std::uint32_t>> fileMaterials_;
   std::uint64_t meshTriangles_ = 0;        // in parts_.meshes
   std::vector<ObjectPlace> objectPlaces_;  // per primitive, where its object was written
+  std::vector<std::string_view> objectTypes_;  // in the order messages list them
+  std::vector<std::string_view> lightTypes_;
 };
 
 }  // namespace

@@ -556,12 +556,17 @@ void ParameterDictionary::finish() {
   finished_ = true;
   std::vector<std::string_view> unknown;
   if (!declared_.empty() || !hidden_.empty()) {
+    for (Item& i : items_) {
+      if (i.used) continue;
+      unknown.push_back(i.name);
+    }
+  }
+  if (!unknown.empty()) {
     std::vector<std::string_view> candidates = declared_;
     candidates.insert(candidates.end(), hidden_.begin(), hidden_.end());
     const std::string offered = fmt::format("{}", fmt::join(declared_, ", "));
     for (Item& i : items_) {
       if (i.used) continue;
-      unknown.push_back(i.name);
       error(i.key, fmt::format("unknown key {} {}; expected one of: {}{}", quoteForMessage(i.name),
                                names_.context, offered, didYouMean(i.name, candidates)));
     }
