@@ -133,8 +133,7 @@ int main(int argc, char** argv) {
       parts.materials.push_back(red);
       parts.primitives.reserve(list.size());
       for (const Sphere& s : list) {
-        parts.primitives.emplace_back(glint::Sphere::make({s.x, s.y, s.z}, s.r), 1,
-                                      glint::Color());
+        parts.primitives.emplace_back(glint::Sphere::make({s.x, s.y, s.z}, s.r), 1, glint::Color());
       }
       parts.lights.push_back(glint::PointLight{{10, 10, 10}, glint::Color(1), {}});
       parts.camera.position = {0, 0, 10};
@@ -151,15 +150,17 @@ int main(int argc, char** argv) {
   const double checkMedian = median(checkSeconds);
   const double fileMiB = megabytes * 1e6 / (1 << 20);
   const double extraMiB = static_cast<double>(checkPeak - builtPeak) / 1024;
-  fmt::print("  glint check:        {:.3f} s median ({:.3f}–{:.3f}), {:.1f} MB/s, peak {:.1f} MiB\n",
-             checkMedian, *std::min_element(checkSeconds.begin(), checkSeconds.end()),
-             *std::max_element(checkSeconds.begin(), checkSeconds.end()), megabytes / checkMedian,
-             static_cast<double>(checkPeak) / 1024);
+  fmt::print(
+      "  glint check:        {:.3f} s median ({:.3f}–{:.3f}), {:.1f} MB/s, peak {:.1f} MiB\n",
+      checkMedian, *std::min_element(checkSeconds.begin(), checkSeconds.end()),
+      *std::max_element(checkSeconds.begin(), checkSeconds.end()), megabytes / checkMedian,
+      static_cast<double>(checkPeak) / 1024);
   fmt::print("  built from memory:  {:.3f} s median, peak {:.1f} MiB\n", median(builtSeconds),
              static_cast<double>(builtPeak) / 1024);
   fmt::print("  reading costs {:.1f} MiB above the built scene = {:.2f} × the file ({:.2f} MiB)\n",
              extraMiB, extraMiB / fileMiB, fileMiB);
-  fmt::print("  targets: >= 20 MB/s {}; <= 3 × file {}\n", megabytes / checkMedian >= 20 ? "met" : "NOT met",
+  fmt::print("  targets: >= 20 MB/s {}; <= 3 × file {}\n",
+             megabytes / checkMedian >= 20 ? "met" : "NOT met",
              extraMiB <= 3 * fileMiB ? "met" : "NOT met");
   fs::remove(scene);
   return 0;

@@ -471,8 +471,8 @@ class Builder {
   std::map<std::uint32_t, TextPosition> materialWhere_;
   MeshCache meshCache_;  // each mesh file read once per scene
   std::map<const MeshFile*, std::vector<std::uint32_t>> fileMaterials_;
-  std::uint64_t meshTriangles_ = 0;        // in parts_.meshes
-  std::vector<ObjectPlace> objectPlaces_;  // per primitive, where its object was written
+  std::uint64_t meshTriangles_ = 0;            // in parts_.meshes
+  std::vector<ObjectPlace> objectPlaces_;      // per primitive, where its object was written
   std::vector<std::string_view> objectTypes_;  // in the order messages list them
   std::vector<std::string_view> lightTypes_;
 };
