@@ -25,12 +25,7 @@
 
 namespace glint {
 
-bool BuildResult::hasErrors() const {
-  for (const Diagnostic& d : diagnostics) {
-    if (d.severity == Diagnostic::Severity::Error) return true;
-  }
-  return false;
-}
+bool BuildResult::hasErrors() const { return glint::hasErrors(diagnostics); }
 
 namespace {
 

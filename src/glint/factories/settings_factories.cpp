@@ -21,6 +21,15 @@ ValueReader readerOf(const SceneDescription& scene, const Entity& e, BuildContex
   return ValueReader(scene.fileOf(e).source(), ctx.sink);
 }
 
+// A scene-wide section (`image: {...}`) as a dictionary named after it, or nullopt after the error
+// "{section}: expected {what}, got ...".
+std::optional<ParameterDictionary> sectionParameters(const SceneDescription& scene, const Entity& e,
+                                                     BuildContext& ctx, std::string_view what,
+                                                     const std::string& section) {
+  return entityParameters(readerOf(scene, e, ctx), e.value, e.place, what,
+                          {"in " + section, section, section});
+}
+
 // image.adaptive, after image.samples: max_samples may not be below the fixed count, and the
 // worst case (every pixel taking max_samples) must pass the same camera-ray limit.
 void buildAdaptive(ParameterDictionary& adaptiveParams, bool checkSize, BuildContext& ctx) {
@@ -61,9 +70,7 @@ void buildAdaptive(ParameterDictionary& adaptiveParams, bool checkSize, BuildCon
 }  // namespace
 
 void buildImage(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
-  const ValueReader reader = readerOf(scene, e, ctx);
-  auto params = entityParameters(reader, e.value, e.place, "a mapping with width and height",
-                                 {"in image", "image", "image"});
+  auto params = sectionParameters(scene, e, ctx, "a mapping with width and height", "image");
   if (!params) return;
   ParameterDictionary& p = *params;
   p.declare({"width", "height", "samples", "encoding", "grid", "adaptive"});
@@ -138,9 +145,7 @@ void buildImage(const SceneDescription& scene, const Entity& e, BuildContext& ct
 void buildRender(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
   RenderSettings& render = ctx.parts.render;
   if (ctx.options.overrides.seed) render.seed = *ctx.options.overrides.seed;
-  const ValueReader reader = readerOf(scene, e, ctx);
-  auto params = entityParameters(reader, e.value, e.place, "a mapping of render settings",
-                                 {"in render", "render", "render"});
+  auto params = sectionParameters(scene, e, ctx, "a mapping of render settings", "render");
   if (!params) return;
   ParameterDictionary& p = *params;
   p.declare({"max_depth", "min_weight", "blur_samples", "seed"});
@@ -157,9 +162,7 @@ void buildRender(const SceneDescription& scene, const Entity& e, BuildContext& c
 }
 
 void buildAmbient(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
-  const ValueReader reader = readerOf(scene, e, ctx);
-  auto params = entityParameters(reader, e.value, e.place, "a mapping {color, intensity}",
-                                 {"in ambient", "ambient", "ambient"});
+  auto params = sectionParameters(scene, e, ctx, "a mapping {color, intensity}", "ambient");
   if (!params) return;
   ParameterDictionary& p = *params;
   p.declare({"color", "intensity"});
@@ -185,11 +188,9 @@ void buildBackground(const SceneDescription& scene, const Entity& e, BuildContex
 }
 
 void buildCamera(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
-  const ValueReader reader = readerOf(scene, e, ctx);
-  auto params =
-      entityParameters(reader, e.value, e.place,
-                       "a mapping with position, direction or look_at, and view_plane or fov",
-                       {"in camera", "camera", "camera"});
+  auto params = sectionParameters(
+      scene, e, ctx, "a mapping with position, direction or look_at, and view_plane or fov",
+      "camera");
   if (!params) return;
   ParameterDictionary& p = *params;
   p.declare({"position", "direction", "look_at", "up", "view_plane", "fov", "aperture",

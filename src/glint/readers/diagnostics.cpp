@@ -48,6 +48,13 @@ std::string escapeForMessage(std::string_view text) { return escaped(text, SIZE_
 
 std::string quoteForMessage(std::string_view text) { return "'" + shortenForMessage(text) + "'"; }
 
+bool hasErrors(const std::vector<Diagnostic>& diagnostics) {
+  for (const Diagnostic& d : diagnostics) {
+    if (d.severity == Diagnostic::Severity::Error) return true;
+  }
+  return false;
+}
+
 std::string Diagnostic::format() const {
   std::string out = where.file;
   if (where.line > 0) {

@@ -38,6 +38,9 @@ std::string shortenForMessage(std::string_view text);
 std::string escapeForMessage(std::string_view text);
 std::string quoteForMessage(std::string_view text);
 
+// Whether any of `diagnostics` is an error (not only warnings).
+bool hasErrors(const std::vector<Diagnostic>& diagnostics);
+
 // Errors and warnings as they are found, in any order (the loader sorts them by place).
 class Diagnostics {
  public:

@@ -276,18 +276,7 @@ std::optional<std::vector<Point3>> ValueReader::pointList(ValueId v, ValueId whe
                              path.str(), count, describe(v)));
     return std::nullopt;
   }
-  std::vector<Point3> out;
-  out.reserve(n);
-  bool ok = true;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (const auto p = point3(tree().item(v, i), itemPlace(v, where, i), path.item(i))) {
-      out.push_back(*p);
-    } else {
-      ok = false;
-    }
-  }
-  if (!ok) return std::nullopt;
-  return out;
+  return items(v, where, path, &ValueReader::point3);
 }
 
 std::optional<std::vector<Vec3>> ValueReader::vectorList(ValueId v, ValueId where,
@@ -298,13 +287,21 @@ std::optional<std::vector<Vec3>> ValueReader::vectorList(ValueId v, ValueId wher
                              path.str(), count, describe(v)));
     return std::nullopt;
   }
-  std::vector<Vec3> out;
+  return items(v, where, path, &ValueReader::vec3);
+}
+
+template <class T>
+std::optional<std::vector<T>> ValueReader::items(
+    ValueId list, ValueId where, const ValuePath& path,
+    std::optional<T> (ValueReader::*read)(ValueId, ValueId, const ValuePath&) const) const {
+  std::vector<T> out;
+  out.reserve(tree().size(list));
   bool ok = true;
-  for (std::size_t i = 0; i < count; ++i) {
-    if (const auto e = vec3(tree().item(v, i), itemPlace(v, where, i), path.item(i))) {
-      out.push_back(*e);
+  for (std::size_t i = 0; i < tree().size(list); ++i) {
+    if (auto item = (this->*read)(tree().item(list, i), itemPlace(list, where, i), path.item(i))) {
+      out.push_back(*item);
     } else {
-      ok = false;
+      ok = false;  // every wrong item is reported
     }
   }
   if (!ok) return std::nullopt;
@@ -440,98 +437,62 @@ const ParameterDictionary::Item* ParameterDictionary::fetch(std::string_view key
   return i;
 }
 
-template <class T, class Read>
-std::optional<Located<T>> ParameterDictionary::get(std::string_view key, Presence p, Read&& read) {
+template <class T, class... Extra>
+std::optional<Located<T>> ParameterDictionary::get(std::string_view key, Presence p,
+                                                   Reader<T, Extra...> read, Extra... extra) {
   const Item* i = fetch(key, p);
   if (i == nullptr) return std::nullopt;
   const ValueId where = placeOf(*i);
-  std::optional<T> value = read(i->value, where, pathOf(key));
+  std::optional<T> value = (reader_.*read)(i->value, where, pathOf(key), extra...);
   if (!value) return std::nullopt;
   return Located<T>{std::move(*value), where};
 }
 
 std::optional<Located<double>> ParameterDictionary::number(std::string_view key, Presence p) {
-  return get<double>(key, p, [this](ValueId v, ValueId w, const ValuePath& path) {
-    return reader_.number(v, w, path);
-  });
+  return get(key, p, &ValueReader::number);
 }
-
 std::optional<Located<std::int64_t>> ParameterDictionary::integer(std::string_view key,
                                                                   Presence p) {
-  return get<std::int64_t>(key, p, [this](ValueId v, ValueId w, const ValuePath& path) {
-    return reader_.integer(v, w, path);
-  });
+  return get(key, p, &ValueReader::integer);
 }
-
 std::optional<Located<std::uint64_t>> ParameterDictionary::unsignedInteger(std::string_view key,
                                                                            Presence p) {
-  return get<std::uint64_t>(key, p, [this](ValueId v, ValueId w, const ValuePath& path) {
-    return reader_.unsignedInteger(v, w, path);
-  });
+  return get(key, p, &ValueReader::unsignedInteger);
 }
-
 std::optional<Located<Vec3>> ParameterDictionary::vec3(std::string_view key, Presence p) {
-  return get<Vec3>(key, p, [this](ValueId v, ValueId w, const ValuePath& path) {
-    return reader_.vec3(v, w, path);
-  });
+  return get(key, p, &ValueReader::vec3);
 }
-
 std::optional<Located<Point3>> ParameterDictionary::point3(std::string_view key, Presence p) {
-  return get<Point3>(key, p, [this](ValueId v, ValueId w, const ValuePath& path) {
-    return reader_.point3(v, w, path);
-  });
+  return get(key, p, &ValueReader::point3);
 }
-
 std::optional<Located<std::array<double, 3>>> ParameterDictionary::triple(std::string_view key,
                                                                           std::string_view what,
                                                                           Presence p) {
-  return get<std::array<double, 3>>(key, p,
-                                    [this, what](ValueId v, ValueId w, const ValuePath& path) {
-                                      return reader_.triple(v, w, path, what);
-                                    });
+  return get(key, p, &ValueReader::triple, what);
 }
-
 std::optional<Located<ColorValue>> ParameterDictionary::color(std::string_view key, Presence p) {
-  return get<ColorValue>(key, p, [this](ValueId v, ValueId w, const ValuePath& path) {
-    return reader_.color(v, w, path);
-  });
+  return get(key, p, &ValueReader::color);
 }
-
 std::optional<Located<Color>> ParameterDictionary::coefficient(std::string_view key, Presence p) {
-  return get<Color>(key, p, [this](ValueId v, ValueId w, const ValuePath& path) {
-    return reader_.coefficient(v, w, path);
-  });
+  return get(key, p, &ValueReader::coefficient);
 }
-
 std::optional<Located<std::string_view>> ParameterDictionary::text(std::string_view key,
                                                                    Presence p) {
-  return get<std::string_view>(key, p, [this](ValueId v, ValueId w, const ValuePath& path) {
-    return reader_.text(v, w, path);
-  });
+  return get(key, p, &ValueReader::text);
 }
-
 std::optional<Located<bool>> ParameterDictionary::boolean(std::string_view key, Presence p) {
-  return get<bool>(key, p, [this](ValueId v, ValueId w, const ValuePath& path) {
-    return reader_.boolean(v, w, path);
-  });
+  return get(key, p, &ValueReader::boolean);
 }
-
 std::optional<Located<std::vector<Point3>>> ParameterDictionary::pointList(std::string_view key,
                                                                            std::size_t minCount,
                                                                            std::size_t maxCount,
                                                                            Presence p) {
-  return get<std::vector<Point3>>(
-      key, p, [this, minCount, maxCount](ValueId v, ValueId w, const ValuePath& path) {
-        return reader_.pointList(v, w, path, minCount, maxCount);
-      });
+  return get(key, p, &ValueReader::pointList, minCount, maxCount);
 }
-
 std::optional<Located<std::vector<Vec3>>> ParameterDictionary::vectorList(std::string_view key,
                                                                           std::size_t count,
                                                                           Presence p) {
-  return get<std::vector<Vec3>>(key, p, [this, count](ValueId v, ValueId w, const ValuePath& path) {
-    return reader_.vectorList(v, w, path, count);
-  });
+  return get(key, p, &ValueReader::vectorList, count);
 }
 
 std::optional<ParameterDictionary> ParameterDictionary::mapping(std::string_view key,

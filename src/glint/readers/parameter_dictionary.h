@@ -94,6 +94,13 @@ class ValueReader {
   ValueId itemPlace(ValueId list, ValueId listWhere, std::size_t i) const;
 
  private:
+  // Every item of a list read by `read`; nullopt when one is wrong (each wrong one reported).
+  template <class T>
+  std::optional<std::vector<T>> items(ValueId list, ValueId where, const ValuePath& path,
+                                      std::optional<T> (ValueReader::*read)(ValueId, ValueId,
+                                                                            const ValuePath&)
+                                          const) const;
+
   SourceText source_;
   Diagnostics& sink_;
 };
@@ -198,8 +205,13 @@ class ParameterDictionary {
   // The value of `key` for a typed getter: marks it used, records a required key as missing.
   const Item* fetch(std::string_view key, Presence p);
   ValueId placeOf(const Item& item) const;
-  template <class T, class Read>
-  std::optional<Located<T>> get(std::string_view key, Presence p, Read&& read);
+  // A typed getter: fetch(key), then the ValueReader conversion `read` of its value and place.
+  template <class T, class... Extra>
+  using Reader = std::optional<T> (ValueReader::*)(ValueId, ValueId, const ValuePath&,
+                                                   Extra...) const;
+  template <class T, class... Extra>
+  std::optional<Located<T>> get(std::string_view key, Presence p, Reader<T, Extra...> read,
+                                Extra... extra);
 
   ValueReader reader_;
   ValueId map_ = kNoValue;

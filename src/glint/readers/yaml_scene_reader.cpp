@@ -12,12 +12,7 @@
 
 namespace glint {
 
-bool ParseResult::hasErrors() const {
-  for (const Diagnostic& d : diagnostics) {
-    if (d.severity == Diagnostic::Severity::Error) return true;
-  }
-  return false;
-}
+bool ParseResult::hasErrors() const { return glint::hasErrors(diagnostics); }
 
 namespace {
 
