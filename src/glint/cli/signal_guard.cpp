@@ -53,7 +53,7 @@ SignalGuard::~SignalGuard() {
 
 const std::atomic<bool>& SignalGuard::cancelFlag() const { return gCancel; }
 
-int SignalGuard::receivedSignal() const { return gSignal.load(); }
+const std::atomic<int>& SignalGuard::signalNumber() const { return gSignal; }
 
 void SignalGuard::setCommitting(bool committing) { gCommitting.store(committing); }
 

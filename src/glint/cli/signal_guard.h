@@ -15,15 +15,16 @@ class SignalGuard {
   SignalGuard(const SignalGuard&) = delete;
   SignalGuard& operator=(const SignalGuard&) = delete;
 
-  // Set by the first SIGINT/SIGTERM; give it to RenderOptions::cancel.
+  // Set by the first SIGINT/SIGTERM; give it to RenderJobSpec::cancel.
   const std::atomic<bool>& cancelFlag() const;
-  // The first signal received, or 0.
-  int receivedSignal() const;
+  // The first signal received, or 0; give it to RenderJobSpec::cancelSignal.
+  const std::atomic<int>& signalNumber() const;
+  int receivedSignal() const { return signalNumber().load(); }
   // The exit status for a run stopped by `signal`: 128 + signal (130 for SIGINT, 143 for SIGTERM).
   static int exitCodeFor(int signal) { return 128 + signal; }
 
-  // While committing (writing the finished image: temporary file, then rename), a second signal
-  // no longer ends the process, so no temporary file can be left behind.
+  // While committing (writing a checkpoint or the finished image: temporary file, then rename), a
+  // second signal no longer ends the process, so no temporary file can be left behind.
   void setCommitting(bool committing);
 };
 

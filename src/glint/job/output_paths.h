@@ -1,0 +1,28 @@
+// Where a render job writes — the image and the checkpoint — checked before any work, so that a
+// typo costs no render and no saved work is overwritten.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+
+namespace glint {
+
+// The image a render writes when none is named: the scene file's name with ".png", in the current
+// folder.
+std::filesystem::path defaultOutputPath(const std::filesystem::path& scene);
+
+// Checks the output image path and throws JobError (job/job_error.h) when it cannot be written:
+// BadInput for an unknown extension or a missing folder; Failure for problems of writing (a folder
+// in its place, an unwritable folder).
+void checkOutputPath(const std::filesystem::path& output);
+
+// The checkpoint file a render writes: `checkpoint`, or else the `resume` file (a resumed render
+// keeps checkpointing, so it can be interrupted again); std::nullopt when neither is given. Throws
+// JobError when a name is empty, when it is the output image, when its folder is missing or not
+// writable, when it names a folder, and when it exists and is not the checkpoint being
+// resumed (work saved in it would be lost).
+std::optional<std::filesystem::path> resolveCheckpointPath(
+    const std::optional<std::filesystem::path>& checkpoint,
+    const std::optional<std::filesystem::path>& resume, const std::filesystem::path& output);
+
+}  // namespace glint
