@@ -7,6 +7,7 @@
 #include <system_error>
 
 #include "glint/image/image_writer.h"
+#include "glint/job/checkpoint.h"
 #include "glint/job/job_error.h"
 
 namespace glint {
@@ -80,8 +81,16 @@ std::optional<fs::path> resolveCheckpointPath(const std::optional<fs::path>& che
     throw JobError(JobFailure::Failure,
                    fmt::format("cannot write checkpoint '{}': the folder '{}' is not writable",
                                path.string(), folder.string()));
+  // Named before anything else about it: a device or a FIFO is refused without being opened.
+  if (resume) {
+    try {
+      checkCheckpointFile(*resume);
+    } catch (const CheckpointError& problem) {
+      throw JobError(JobFailure::BadInput, fmt::format("cannot resume: {}", problem.what()));
+    }
+  }
   // Starting afresh over an existing checkpoint would throw away the work saved in it.
-  const bool continuesIt = resume && fs::equivalent(path, *resume, error);
+  const bool continuesIt = resume && sameFile(path, *resume);
   if (!continuesIt && fs::exists(path, error))
     throw JobError(JobFailure::BadInput,
                    fmt::format("the checkpoint '{}' already exists; continue it with --resume {}, "

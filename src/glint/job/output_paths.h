@@ -19,8 +19,9 @@ void checkOutputPath(const std::filesystem::path& output);
 // The checkpoint file a render writes: `checkpoint`, or else the `resume` file (a resumed render
 // keeps checkpointing, so it can be interrupted again); std::nullopt when neither is given. Throws
 // JobError when a name is empty, when it is the output image, when its folder is missing or not
-// writable, when it names a folder, and when it exists and is not the checkpoint being
-// resumed (work saved in it would be lost).
+// writable, when it names a folder, when it exists and is not the checkpoint being resumed (work
+// saved in it would be lost), and when `resume` is not a regular file (a device or a FIFO would
+// never finish reading or never open).
 std::optional<std::filesystem::path> resolveCheckpointPath(
     const std::optional<std::filesystem::path>& checkpoint,
     const std::optional<std::filesystem::path>& resume, const std::filesystem::path& output);

@@ -1,0 +1,99 @@
+// The render job behind the command line (issues 12 and 13), tested by running the built binary:
+// what it refuses before any work, how it stops, what it leaves behind and what it prints.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <climits>
+#include <filesystem>
+#include <regex>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli_harness.h"
+#include "glint/core/atomic_file.h"
+
+namespace glint_cli_test {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+// Waits until glint handles `signal`, lets it work a moment, sends the signal, and returns how it
+// ended and how long it took to end.
+struct Stopped {
+  RunResult result;
+  std::chrono::duration<double> took{};
+};
+
+class CliJob : public Cli {
+ protected:
+  // Runs `args` in the background and stops it with `signal` once stderr matches `ready` and
+  // `warmUp` has passed.
+  Stopped stopWith(int signal, const std::vector<std::string>& args, const std::regex& ready,
+                   std::chrono::milliseconds warmUp = 0ms) {
+    const pid_t pid = start(args);
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
+    while (!catchesSignal(pid, signal) && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(2ms);
+    EXPECT_TRUE(catchesSignal(pid, signal)) << "glint never installed its handler for " << signal;
+    while (!std::regex_search(readFile(root_ / "capture" / "stderr"), ready) &&
+           std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(1ms);
+    std::this_thread::sleep_for(warmUp);
+    const auto sent = std::chrono::steady_clock::now();
+    kill(pid, signal);
+    Stopped stopped;
+    stopped.result = finish(pid, 10s);
+    stopped.took = std::chrono::steady_clock::now() - sent;
+    return stopped;
+  }
+
+  // small.yaml at 128x96 on one thread (48 tiles, stopped once it has reported progress), with
+  // `extra` options.
+  std::vector<std::string> slowRender(const std::vector<std::string>& extra) const {
+    std::vector<std::string> args{"render", small(), "--width", "128", "--threads", "1"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  }
+  const std::regex someProgress{R"(glint: [1-9][0-9]?% )"};
+
+  // small.yaml with `from` replaced by `to` (which must be there), written into the root folder.
+  std::string variant(const std::string& name, const std::string& from, const std::string& to) {
+    std::string text = readFile(kScenes / "small.yaml");
+    EXPECT_NE(text.find(from), std::string::npos) << from;
+    if (text.find(from) != std::string::npos) text.replace(text.find(from), from.size(), to);
+    writeFile(root_ / name, text);
+    return (root_ / name).string();
+  }
+};
+
+// --- inputs are read safely and never overwritten -----------------------------------------
+
+// Today's bug: --resume /dev/zero read 6 GB in 17 s, ignoring SIGINT; a FIFO blocked forever.
+// Both are refused by their stat, before the scene is even loaded. The memory cap turns a
+// runaway read into a quick failure instead of a machine swapping.
+TEST_F(CliJob, ResumeRefusesDevicesAndFifosWithoutReadingThem) {
+  constexpr std::uint64_t kAddressSpace = std::uint64_t{2} << 30;
+  RunResult r =
+      run({"render", small(), "-o", "out.png", "--resume", "/dev/zero", "--checkpoint", "new.ckpt"},
+          5s, kAddressSpace);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err,
+                       "glint: error: cannot resume: cannot read checkpoint '/dev/zero': it "
+                       "is not a regular file (a device, FIFO or socket)"))
+      << r.err;
+  ASSERT_EQ(mkfifo((work_ / "run.ckpt").c_str(), 0600), 0);
+  r = run({"render", small(), "-o", "out.png", "--resume", "run.ckpt"}, 5s, kAddressSpace);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "cannot read checkpoint 'run.ckpt': it is not a regular file"))
+      << r.err;
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{"run.ckpt"});
+}
+
+}  // namespace
+}  // namespace glint_cli_test
