@@ -95,5 +95,14 @@ TEST_F(CliJob, ResumeRefusesDevicesAndFifosWithoutReadingThem) {
   EXPECT_EQ(filesIn(work_), std::set<std::string>{"run.ckpt"});
 }
 
+TEST_F(CliJob, AnEmptyResumeNameNamesTheResumeOption) {
+  const RunResult r = run({"render", small(), "-o", "out.png", "--resume", ""});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "glint: error: --resume needs a file name\n");
+  const RunResult checkpoint = run({"render", small(), "-o", "out.png", "--checkpoint", ""});
+  EXPECT_EQ(checkpoint.err, "glint: error: --checkpoint needs a file name\n");
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
 }  // namespace
 }  // namespace glint_cli_test

@@ -63,8 +63,10 @@ std::optional<fs::path> resolveCheckpointPath(const std::optional<fs::path>& che
                                               const std::optional<fs::path>& resume,
                                               const fs::path& out) {
   if (!checkpoint && !resume) return std::nullopt;
+  if (checkpoint && checkpoint->empty())
+    throw JobError(JobFailure::BadInput, "--checkpoint needs a file name");
+  if (resume && resume->empty()) throw JobError(JobFailure::BadInput, "--resume needs a file name");
   const fs::path path = checkpoint ? *checkpoint : *resume;
-  if (path.empty()) throw JobError(JobFailure::BadInput, "--checkpoint needs a file name");
   std::error_code error;
   if (sameFile(path, out))
     throw JobError(JobFailure::BadInput,
