@@ -104,5 +104,31 @@ TEST_F(CliJob, AnEmptyResumeNameNamesTheResumeOption) {
   EXPECT_TRUE(filesIn(work_).empty());
 }
 
+// Today's bug: `glint render scene.png -o scene.png` replaced the scene with the image, exit 0.
+TEST_F(CliJob, AnOutputThatIsAnInputIsRefused) {
+  const std::string scene = readFile(kScenes / "small.yaml");
+  writeFile(work_ / "scene.png", scene);
+  fs::create_hard_link(work_ / "scene.png", work_ / "alias.png");
+  const std::vector<std::vector<std::string>> attempts{
+      {"render", "scene.png", "-o", "scene.png"},
+      {"render", "scene.png"},  // the default output: the scene's name with .png, here
+      {"render", "scene.png", "-o", "./scene.png"},
+      {"render", (work_ / "scene.png").string(), "-o", "scene.png"},
+      {"render", "scene.png", "-o", "alias.png"}};  // the same file under another name
+  for (const std::vector<std::string>& args : attempts) {
+    const RunResult r = run(args);
+    EXPECT_EQ(r.status, 2) << args.back() << "\n" << r.err;
+    EXPECT_TRUE(contains(r.err, "': it is the scene file")) << r.err;
+  }
+  // A checkpoint being resumed is an input too.
+  writeFile(work_ / "run.png", "a checkpoint with an odd name");
+  const RunResult resumed =
+      run({"render", small(), "-o", "run.png", "--resume", "run.png", "--checkpoint", "new.ckpt"});
+  EXPECT_EQ(resumed.status, 2);
+  EXPECT_EQ(resumed.err, "glint: error: the checkpoint 'run.png' cannot be the output image\n");
+  EXPECT_EQ(readFile(work_ / "scene.png"), scene);
+  EXPECT_EQ(filesIn(work_), (std::set<std::string>{"alias.png", "run.png", "scene.png"}));
+}
+
 }  // namespace
 }  // namespace glint_cli_test

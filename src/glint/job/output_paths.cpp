@@ -35,7 +35,8 @@ bool sameFile(const fs::path& a, const fs::path& b) {
 
 fs::path defaultOutputPath(const fs::path& scene) { return scene.stem().concat(".png"); }
 
-void checkOutputPath(const fs::path& out) {
+void checkOutputPath(const fs::path& out, const fs::path& scene,
+                     const std::optional<fs::path>& resume) {
   if (!writerForPath(out)) {
     const std::string extension = out.extension().string();
     throw JobError(JobFailure::BadInput,
@@ -49,6 +50,13 @@ void checkOutputPath(const fs::path& out) {
     throw JobError(JobFailure::BadInput,
                    fmt::format("cannot write '{}': the folder '{}' does not exist", out.string(),
                                folder.string()));
+  // The image replaces its target only when complete, but it would still replace an input.
+  if (!scene.empty() && sameFile(out, scene))
+    throw JobError(JobFailure::BadInput,
+                   fmt::format("cannot write '{}': it is the scene file", out.string()));
+  if (resume && !resume->empty() && sameFile(out, *resume))
+    throw JobError(JobFailure::BadInput,
+                   fmt::format("the checkpoint '{}' cannot be the output image", resume->string()));
   // Writing problems (exit 1) that can be seen now rather than after the render.
   if (fs::is_directory(out, error))
     throw JobError(JobFailure::Failure,

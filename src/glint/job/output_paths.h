@@ -1,5 +1,5 @@
 // Where a render job writes — the image and the checkpoint — checked before any work, so that a
-// typo costs no render and no saved work is overwritten.
+// typo costs no render and no input file is ever overwritten by an output.
 #pragma once
 
 #include <filesystem>
@@ -12,9 +12,12 @@ namespace glint {
 std::filesystem::path defaultOutputPath(const std::filesystem::path& scene);
 
 // Checks the output image path and throws JobError (job/job_error.h) when it cannot be written:
-// BadInput for an unknown extension or a missing folder; Failure for problems of writing (a folder
-// in its place, an unwritable folder).
-void checkOutputPath(const std::filesystem::path& output);
+// BadInput for an unknown extension, a missing folder, or a path that is one of the render's inputs
+// (`scene`, the `resume` checkpoint; compared by file identity and lexically, so "-o scene.png" on
+// a scene file named scene.png is refused); Failure for problems of writing (a folder in its place,
+// an unwritable folder). `scene` may be empty (a scene built in code).
+void checkOutputPath(const std::filesystem::path& output, const std::filesystem::path& scene,
+                     const std::optional<std::filesystem::path>& resume);
 
 // The checkpoint file a render writes: `checkpoint`, or else the `resume` file (a resumed render
 // keeps checkpointing, so it can be interrupted again); std::nullopt when neither is given. Throws

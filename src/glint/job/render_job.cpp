@@ -81,7 +81,7 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
   if (!fromFile && spec.output.empty())
     throw JobError(JobFailure::BadInput, "a scene built in code needs an output path");
   const fs::path out = spec.output.empty() ? defaultOutputPath(spec.scene) : spec.output;
-  checkOutputPath(out);
+  checkOutputPath(out, fromFile ? spec.scene : fs::path(), spec.resume);
   const std::optional<fs::path> checkpointPath =
       resolveCheckpointPath(spec.checkpoint, spec.resume, out);
 

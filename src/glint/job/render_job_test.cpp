@@ -170,6 +170,15 @@ TEST_F(RenderJobTest, ErrorsCarryTheirExitStatusAndScenesTheirPlaces) {
   fs::create_directory(folder_ / "taken.png");
   EXPECT_EQ(failure(spec("taken.png")).exitCode(), 1) << "a folder in the way: a write failure";
 
+  // The output may not be an input: here the scene file itself.
+  fs::copy_file(kSmallScene, folder_ / "scene.png");
+  RenderJobSpec overwrite = spec("scene.png");
+  overwrite.scene = folder_ / "scene.png";
+  const JobError input = failure(overwrite);
+  EXPECT_EQ(input.exitCode(), 2);
+  EXPECT_NE(std::string(input.what()).find("it is the scene file"), std::string::npos);
+  EXPECT_EQ(readFile(folder_ / "scene.png"), readFile(kSmallScene));
+
   std::ofstream(folder_ / "broken.yaml") << "image: { width: 0, height: 10 }\n";
   RenderJobSpec broken = spec("broken.png");
   broken.scene = folder_ / "broken.yaml";
