@@ -130,5 +130,23 @@ TEST_F(CliJob, AnOutputThatIsAnInputIsRefused) {
   EXPECT_EQ(filesIn(work_), (std::set<std::string>{"alias.png", "run.png", "scene.png"}));
 }
 
+// --- file names, signals and temporary files ----------------------------------------------
+
+// Today's bug: a legal 254-byte output name rendered fully, then failed (exit 1) because the
+// temporary file's name was longer than NAME_MAX. Checkpoints had the same problem.
+TEST_F(CliJob, TheLongestLegalFileNamesAreWritten) {
+  const std::string image = std::string(NAME_MAX - 4, 'i') + ".png";
+  const RunResult r = run({"render", small(), "-o", image, "--quiet"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{image});
+  fs::remove(work_ / image);
+
+  const std::string checkpoint = std::string(NAME_MAX - 5, 'c') + ".ckpt";
+  const Stopped stopped =
+      stopWith(SIGINT, slowRender({"-o", image, "--checkpoint", checkpoint}), someProgress);
+  EXPECT_EQ(stopped.result.status, 130) << stopped.result.err;
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{checkpoint}) << stopped.result.err;
+}
+
 }  // namespace
 }  // namespace glint_cli_test
