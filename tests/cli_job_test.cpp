@@ -148,5 +148,17 @@ TEST_F(CliJob, TheLongestLegalFileNamesAreWritten) {
   EXPECT_EQ(filesIn(work_), std::set<std::string>{checkpoint}) << stopped.result.err;
 }
 
+// Today's bug: SIGHUP (the terminal or the ssh session closed) killed the render outright.
+TEST_F(CliJob, SighupStopsTheRenderWith129AndSavesTheCheckpoint) {
+  const Stopped stopped =
+      stopWith(SIGHUP, slowRender({"-o", "out.png", "--checkpoint", "run.ckpt"}), someProgress);
+  EXPECT_EQ(stopped.result.status, 129) << stopped.result.err;
+  EXPECT_TRUE(std::regex_search(stopped.result.err,
+                                std::regex(R"(glint: interrupted; \d+ of \d+ tiles saved to )")))
+      << stopped.result.err;
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{"run.ckpt"}) << "no image, no temporary file";
+  EXPECT_EQ(readFile(work_ / "run.ckpt").substr(0, 8), "GLINTCKP");
+}
+
 }  // namespace
 }  // namespace glint_cli_test

@@ -496,8 +496,8 @@ int runCommandLine(int argc, char** argv) {
   // Set after the subcommands exist: CLI11 copies a parent's footer into subcommands made later.
   const std::string exitStatus =
       "Exit status: 0 success; 1 failure while rendering or writing; 2 bad arguments, a bad scene, "
-      "a request refused as too large or a checkpoint that does not match; 130/143 interrupted "
-      "by SIGINT/SIGTERM (no output written; the --checkpoint file saved).";
+      "a request refused as too large or a checkpoint that does not match; 130/143/129 "
+      "interrupted by SIGINT/SIGTERM/SIGHUP (no output written; the --checkpoint file saved).";
   app.footer(
       "Examples:\n  glint render scene.yaml -o scene.png --width 800\n"
       "  glint render scene.yaml --crop 0,0,400,300 -o top-left.ppm\n"
