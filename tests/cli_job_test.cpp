@@ -160,5 +160,34 @@ TEST_F(CliJob, SighupStopsTheRenderWith129AndSavesTheCheckpoint) {
   EXPECT_EQ(readFile(work_ / "run.ckpt").substr(0, 8), "GLINTCKP");
 }
 
+// Today's bug: SIGKILL while writing left ".out.png.tmp-PID-0" beside the output for good. A
+// killed run's temporary file (the name glint gives it, with a PID no process has) goes on the
+// next run into that folder; those of living processes, of other hosts, and files that merely
+// look alike stay.
+TEST_F(CliJob, TemporaryFilesOfKilledRunsAreRemovedByTheNextRun) {
+  std::string probeName;
+  {
+    glint::AtomicFile probe(work_ / "probe");
+    probeName = probe.temporaryPath().filename();
+  }
+  const std::string prefix(glint::kTemporaryFilePrefix);
+  const std::string host = probeName.substr(prefix.size(), 8);
+  const std::string otherHost = host == "00000000" ? "11111111" : "00000000";
+  const std::string killed = prefix + host + "-2147483646-a1b2c3";  // beyond any pid_max
+  const std::string living = prefix + host + "-" + std::to_string(getpid()) + "-a1b2c3";
+  const std::string elsewhere = prefix + otherHost + "-2147483646-a1b2c3";
+  const std::string lookalike = ".out.png.tmp-2147483646-0";
+  fs::create_directory(work_ / "ckpt");
+  for (const fs::path& file : {work_ / killed, work_ / living, work_ / elsewhere, work_ / lookalike,
+                               work_ / "ckpt" / killed})
+    writeFile(file, "half an image");
+  const RunResult r =
+      run({"render", small(), "-o", "out.png", "--checkpoint", "ckpt/run.ckpt", "--quiet"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(filesIn(work_),
+            (std::set<std::string>{"ckpt", "out.png", living, elsewhere, lookalike}));
+  EXPECT_TRUE(filesIn(work_ / "ckpt").empty());
+}
+
 }  // namespace
 }  // namespace glint_cli_test

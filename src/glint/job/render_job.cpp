@@ -9,6 +9,7 @@
 #include <system_error>
 #include <utility>
 
+#include "glint/core/atomic_file.h"
 #include "glint/core/cancel.h"
 #include "glint/image/image_writer.h"
 #include "glint/job/checkpoint.h"
@@ -23,6 +24,10 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+fs::path folderOf(const fs::path& path) {
+  return path.parent_path().empty() ? fs::path(".") : path.parent_path();
 }
 
 // The scene file's bytes once more, for the checkpoint fingerprint. Only a regular file of at most
@@ -84,6 +89,10 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
   checkOutputPath(out, fromFile ? spec.scene : fs::path(), spec.resume);
   const std::optional<fs::path> checkpointPath =
       resolveCheckpointPath(spec.checkpoint, spec.resume, out);
+  // Temporary files of glint processes that were killed while writing (core/atomic_file.h).
+  removeStaleTemporaryFiles(folderOf(out));
+  if (checkpointPath && folderOf(*checkpointPath) != folderOf(out))
+    removeStaleTemporaryFiles(folderOf(*checkpointPath));
 
   RenderJobResult result;
   result.output = out;

@@ -11,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "glint/core/atomic_file.h"
 #include "glint/factories/scene_loader.h"
 
 namespace glint {
@@ -186,6 +187,22 @@ TEST_F(RenderJobTest, ErrorsCarryTheirExitStatusAndScenesTheirPlaces) {
   EXPECT_EQ(scene.exitCode(), 2);
   ASSERT_FALSE(scene.diagnostics().empty());
   EXPECT_EQ(scene.diagnostics()[0].where.file, (folder_ / "broken.yaml").string());
+}
+
+// glint processes killed while writing leave temporary files; the next job in that folder
+// removes those of processes that are gone.
+TEST_F(RenderJobTest, StaleTemporaryFilesAreRemovedBeforeTheJobWrites) {
+  std::string name;
+  {
+    AtomicFile probe(folder_ / "probe");
+    name = probe.temporaryPath().filename();
+  }
+  // Same host, an impossible PID (beyond pid_max): no such process.
+  const std::string host = name.substr(kTemporaryFilePrefix.size(), 8);
+  const std::string stale = std::string(kTemporaryFilePrefix) + host + "-2147483646-zzzzzz";
+  std::ofstream(folder_ / stale) << "half an image";
+  ASSERT_EQ(runRenderJob(spec("out.ppm")).outcome, RenderJobResult::Outcome::Written);
+  EXPECT_EQ(files(), (std::set<std::string>{"out.ppm", "scene.yaml"}));
 }
 
 }  // namespace
