@@ -189,5 +189,36 @@ TEST_F(CliJob, TemporaryFilesOfKilledRunsAreRemovedByTheNextRun) {
   EXPECT_TRUE(filesIn(work_ / "ckpt").empty());
 }
 
+// --- absurd work per pixel ----------------------------------------------------------------
+
+// Today's bug: a 1x1 image at 65536 samples under a 65536-sample area light (every value in range)
+// never finished and ignored SIGINT/SIGTERM: the renderer polled only between pixels.
+TEST_F(CliJob, APixelOfBillionsOfRaysWarnsAndStopsWithinASecond) {
+  const std::string scene = variant("absurd.yaml", "  width: 32\n  height: 24\n  samples: 4\n",
+                                    "  width: 1\n  height: 1\n  samples: 65536\n");
+  std::string text = readFile(scene);
+  text +=
+      "  - { type: area, shape: disk, center: [0, 3, 0], normal: [0, -1, 0], radius: 0.5,\n"
+      "      samples: 65536 }\n";
+  writeFile(scene, text);
+  const std::string warning = "absurd.yaml: warning: one pixel may trace about ";
+  const RunResult check = run({"check", scene});
+  ASSERT_EQ(check.status, 0) << check.err;
+  EXPECT_TRUE(contains(check.err, warning)) << check.err;
+  EXPECT_TRUE(contains(check.err, "65536 samples × ")) << check.err;
+  EXPECT_TRUE(contains(check.err, "65538 shadow")) << check.err;  // the area light, two others
+  EXPECT_TRUE(filesIn(work_).empty());
+
+  for (const int signal : {SIGINT, SIGTERM}) {
+    const Stopped stopped =
+        stopWith(signal, {"render", scene, "-o", "out.png"}, std::regex(warning), 300ms);
+    EXPECT_EQ(stopped.result.status, 128 + signal) << stopped.result.err;
+    EXPECT_TRUE(contains(stopped.result.err, warning)) << stopped.result.err;
+    // The renderer stops within one sample; the bound leaves room for a loaded machine.
+    EXPECT_LT(stopped.took, 2s) << "signal " << signal;
+    EXPECT_TRUE(filesIn(work_).empty());
+  }
+}
+
 }  // namespace
 }  // namespace glint_cli_test

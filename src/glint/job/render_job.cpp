@@ -121,6 +121,8 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
   } catch (const Cancelled&) {
     return interrupted();
   }
+  if (std::optional<Diagnostic> warning = pixelWorkWarning(sceneName, parts))
+    warnings.push_back(std::move(*warning));
   if (events.sceneWarnings && !warnings.empty()) events.sceneWarnings(warnings);
   ImageSettings allocated = parts.image;
   if (const std::optional<PixelRegion>& crop = spec.crop) {

@@ -120,10 +120,10 @@ struct RenderJobResult {
 
 // Runs the job: checks the output and checkpoint paths before any work, removes temporary files
 // that killed glint processes left in those folders, loads the scene (overrides, memory budget,
-// cancel flag), enforces the image limits, builds the scene, sets up checkpoint/resume
-// (fingerprint, mismatch, periodic saves), renders, and writes the image atomically. Throws
-// JobError for bad input (exit status 2) and failures (1); a stop through the cancel flag is not an
-// error but an Interrupted result.
+// cancel flag), warns about absurd pixel work, enforces the image limits, builds the scene, sets up
+// checkpoint/resume (fingerprint, mismatch, periodic saves), renders, and writes the image
+// atomically. Throws JobError for bad input (exit status 2) and failures (1); a stop through the
+// cancel flag is not an error but an Interrupted result.
 RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events = {});
 
 }  // namespace glint

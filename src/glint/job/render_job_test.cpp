@@ -189,6 +189,41 @@ TEST_F(RenderJobTest, ErrorsCarryTheirExitStatusAndScenesTheirPlaces) {
   EXPECT_EQ(scene.diagnostics()[0].where.file, (folder_ / "broken.yaml").string());
 }
 
+TEST_F(RenderJobTest, CheckReturnsTheFactsAndTheWarnings) {
+  std::ofstream(folder_ / "absurd.yaml")
+      << readFile(kSmallScene)
+      << "  - { type: area, shape: disk, center: [0, 3, 0], normal: [0, -1, 0], radius: 0.5,\n"
+         "      samples: 65536 }\n";
+  std::string text = readFile(folder_ / "absurd.yaml");
+  text.replace(text.find("samples: 4\n"), 11, "samples: 65536\n");
+  std::ofstream(folder_ / "absurd.yaml") << text;
+  CheckOptions options;
+  std::vector<Diagnostic> warnings;
+  options.warnings = [&](const std::vector<Diagnostic>& w) { warnings = w; };
+  const SceneFacts facts = checkScene(folder_ / "absurd.yaml", options);
+  EXPECT_EQ(facts.objects, 4u);
+  EXPECT_EQ(facts.lights, 3u);
+  EXPECT_EQ(facts.areaLights, 1u);
+  EXPECT_TRUE(facts.ambient);
+  EXPECT_EQ(facts.samplesPerPixel.minimum, 65536);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0].severity, Diagnostic::Severity::Warning);
+  EXPECT_NE(warnings[0].message.find("65536 samples"), std::string::npos) << warnings[0].message;
+
+  // The render warns the same way, before it starts; stopping it from there writes nothing.
+  std::atomic<bool> cancel{false};
+  RenderJobSpec job = spec("absurd.png");
+  job.scene = folder_ / "absurd.yaml";
+  job.cancel = &cancel;
+  RenderJobEvents events;
+  events.sceneWarnings = [&](const std::vector<Diagnostic>& w) {
+    EXPECT_EQ(w.size(), 1u);
+    cancel.store(true);
+  };
+  EXPECT_EQ(runRenderJob(job, events).outcome, RenderJobResult::Outcome::Interrupted);
+  EXPECT_FALSE(fs::exists(folder_ / "absurd.png"));
+}
+
 // glint processes killed while writing leave temporary files; the next job in that folder
 // removes those of processes that are gone.
 TEST_F(RenderJobTest, StaleTemporaryFilesAreRemovedBeforeTheJobWrites) {

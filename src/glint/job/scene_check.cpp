@@ -10,6 +10,15 @@
 #include "glint/job/job_steps.h"
 
 namespace glint {
+namespace {
+
+// Whole numbers as digits up to a million, then in words ("4.3 billion").
+std::string countText(double count) {
+  return count < 1e6 ? fmt::format("{:.0f}", count) : formatCount(count);
+}
+
+}  // namespace
+
 LoadedScene loadSceneFile(const std::filesystem::path& file, const LoadOptions& options) {
   try {
     return loadScene(file, options);
@@ -68,11 +77,33 @@ SceneFacts sceneFacts(const Scene& scene) {
   return facts;
 }
 
+std::optional<Diagnostic> pixelWorkWarning(const std::string& file, const SceneParts& parts) {
+  const PixelWork work =
+      estimatePixelWork(parts.image, parts.render, parts.lights, parts.materials);
+  const double rays = work.raysPerPixel();
+  if (!(rays > kAbsurdRaysPerPixel)) return std::nullopt;
+  const double perHit =
+      1 + static_cast<double>(work.shadowRaysPerHit) + static_cast<double>(work.glossyRaysPerHit);
+  return Diagnostic{
+      Diagnostic::Severity::Warning,
+      {file, 0, 0},
+      fmt::format("one pixel may trace about {} rays ({} {} × {} surface {} per sample × {} rays "
+                  "per hit: {} shadow, {} glossy and the ray to the hit), more than {}; the render "
+                  "may never finish. Lower image.samples, image.adaptive.max_samples, the area "
+                  "lights' samples, render.blur_samples or render.max_depth",
+                  countText(rays), work.samples, work.samples == 1 ? "sample" : "samples",
+                  countText(work.hitsPerSample), work.hitsPerSample == 1 ? "hit" : "hits",
+                  countText(perHit), work.shadowRaysPerHit, work.glossyRaysPerHit,
+                  countText(kAbsurdRaysPerPixel))};
+}
+
 SceneFacts checkScene(const std::filesystem::path& file, const CheckOptions& options) {
   LoadOptions load;
   load.memoryBudget = options.memoryBudget;
   load.cancel = options.cancel;
   LoadedScene loaded = loadSceneFile(file, load);
+  if (std::optional<Diagnostic> warning = pixelWorkWarning(file.string(), loaded.parts))
+    loaded.warnings.push_back(std::move(*warning));
   if (options.warnings && !loaded.warnings.empty()) options.warnings(loaded.warnings);
   enforceImageLimits(loaded.parts.image, "", options.memoryBudget);
   return sceneFacts(freezeScene(std::move(loaded.parts), file.string()));

@@ -1,5 +1,6 @@
 // `glint check` in the library: load and build a scene, and the facts about it that the check and
-// the render summary print (counts, bounds, the true samples per pixel).
+// the render summary print (counts, bounds, the true samples per pixel), plus the warning for a
+// pixel whose work is absurd.
 #pragma once
 
 #include <atomic>
@@ -38,11 +39,20 @@ struct SceneFacts {
 
 SceneFacts sceneFacts(const Scene& scene);
 
+// One pixel tracing more than this many rays (estimatePixelWork) is worth a warning: at a few
+// million rays per second per core it takes seconds for a single pixel.
+inline constexpr double kAbsurdRaysPerPixel = 1e7;
+
+// "FILE: warning: one pixel may trace about 4.3 billion rays (...)" naming the factors, when the
+// estimate passes kAbsurdRaysPerPixel; std::nullopt otherwise.
+std::optional<Diagnostic> pixelWorkWarning(const std::string& file, const SceneParts& parts);
+
 struct CheckOptions {
   std::uint64_t memoryBudget = defaultImageMemoryBudget();  // as LoadOptions::memoryBudget
   // Polled while loading (factories/scene_loader.h); when set the check throws Cancelled.
   const std::atomic<bool>* cancel = nullptr;
-  // Hears the scene's warnings as soon as it is loaded, before anything can fail later.
+  // Hears the scene's warnings (the loader's, then pixelWorkWarning's) as soon as it is loaded,
+  // before anything can fail later.
   std::function<void(const std::vector<Diagnostic>&)> warnings;
 };
 
