@@ -220,5 +220,24 @@ TEST_F(CliJob, APixelOfBillionsOfRaysWarnsAndStopsWithinASecond) {
   }
 }
 
+// --- what the summaries and --quiet print -------------------------------------------------
+
+// Every pixel takes at least 4 samples under adaptive sampling, so `samples: 1` is not "1 to 64".
+TEST_F(CliJob, TheAdaptiveRangeStartsAtTheSamplesEveryPixelTakes) {
+  const std::string scene =
+      variant("adaptive.yaml", "  samples: 4\n",
+              "  samples: 1\n  adaptive: { max_samples: 64, threshold: 0.05 }\n");
+  const RunResult check = run({"check", scene});
+  ASSERT_EQ(check.status, 0) << check.err;
+  EXPECT_TRUE(contains(check.out, "32x24, 4 to 64 samples per pixel (adaptive, threshold 0.05)"))
+      << check.out;
+  const RunResult r = run({"render", scene, "-o", "out.png", "--stats"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(
+      r.err, std::regex(R"(glint: samples: \d+ \([0-9.]+ per pixel on average, 4 to 64\))")))
+      << r.err;
+  EXPECT_TRUE(contains(r.err, "4 to 64 samples per pixel (adaptive")) << r.err;
+}
+
 }  // namespace
 }  // namespace glint_cli_test

@@ -190,13 +190,14 @@ std::string lightsText(const SceneFacts& scene) {
 }
 
 // "4 samples per pixel", or with adaptive sampling "4 to 64 samples per pixel (adaptive,
-// threshold 0.05)".
+// threshold 0.05)": the samples every pixel takes (at least 4 when adaptive) to the most any may.
 std::string samplesText(const SceneFacts& scene) {
   const ImageSettings& image = scene.image;
   if (!image.adaptive)
     return fmt::format("{} {} per pixel", image.samples, image.samples == 1 ? "sample" : "samples");
-  return fmt::format("{} to {} samples per pixel (adaptive, threshold {:g})", image.samples,
-                     image.adaptive->maxSamples, image.adaptive->threshold);
+  return fmt::format("{} to {} samples per pixel (adaptive, threshold {:g})",
+                     scene.samplesPerPixel.minimum, scene.samplesPerPixel.maximum,
+                     image.adaptive->threshold);
 }
 
 const char* plural(std::uint64_t n, const char* one, const char* many) {
@@ -229,7 +230,7 @@ void printSummary(const RenderJobResult& result) {
     text +=
         fmt::format("glint: samples: {} ({:.2f} per pixel on average, {} to {})\n", rays.camera,
                     static_cast<double>(rays.camera) / static_cast<double>(result.pixelsRendered),
-                    scene.image.samples, scene.image.adaptive->maxSamples);
+                    scene.samplesPerPixel.minimum, scene.samplesPerPixel.maximum);
   if (stats.nonFinite > 0) {
     text += fmt::format("glint: {} NaN/inf {} replaced by black", stats.nonFinite,
                         stats.nonFinite == 1 ? "sample" : "samples");
