@@ -239,5 +239,16 @@ TEST_F(CliJob, TheAdaptiveRangeStartsAtTheSamplesEveryPixelTakes) {
   EXPECT_TRUE(contains(r.err, "4 to 64 samples per pixel (adaptive")) << r.err;
 }
 
+// Today's bug: oneTBB printed "TBB Warning: The number of workers is currently limited to 1 ..."
+// under --quiet when --threads exceeded the cores.
+TEST_F(CliJob, QuietWithMoreThreadsThanCoresPrintsNothing) {
+  for (const char* threads : {"64", "4096"}) {
+    const RunResult r = run({"render", small(), "-o", "out.png", "--quiet", "--threads", threads});
+    EXPECT_EQ(r.status, 0) << threads;
+    EXPECT_EQ(r.err, "") << threads;
+    EXPECT_EQ(r.out, "") << threads;
+  }
+}
+
 }  // namespace
 }  // namespace glint_cli_test

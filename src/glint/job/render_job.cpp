@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <sys/stat.h>
+#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -79,6 +80,14 @@ class Committing {
 }  // namespace
 
 RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) {
+  // --threads N means N threads for the whole job: without this limit, oneTBB sizes its worker pool
+  // at the first parallel loop (the BVH build: all cores) and warns on stderr when the render then
+  // asks for more.
+  std::optional<tbb::global_control> parallelism;
+  if (spec.threads > 0)
+    parallelism.emplace(tbb::global_control::max_allowed_parallelism,
+                        static_cast<std::size_t>(spec.threads));
+
   const bool fromFile = !spec.sceneParts.has_value();
   if (!fromFile && (spec.checkpoint || spec.resume))
     throw JobError(JobFailure::BadInput,

@@ -34,7 +34,9 @@ struct RenderJobSpec {
   // How the caller names what changed the image or the limits ("--width 70000 --max-memory 3M"),
   // quoted in a refusal; empty when nothing did.
   std::string requestText;
-  int threads = 0;                  // worker threads for the render, 0 for all cores
+  // Worker threads, 0 for all cores. A positive count also limits loading and the BVH build, for
+  // the whole process while the job runs (oneTBB's global_control).
+  int threads = 0;
   std::optional<PixelRegion> crop;  // render only this region of the image; it is the image
   std::uint64_t memoryBudget = defaultImageMemoryBudget();  // bytes; see LoadOptions
   // Saves the finished tiles there periodically and when stopped; removed once the image is
