@@ -1,5 +1,6 @@
 // The seed document's test case — four triangles and a sphere under ambient light, with the yellow
-// grid — built in code (no scene file), rendered and written as a PNG.
+// grid — built in code (no scene file) and rendered through the same render job as `glint render`
+// (atomic output, the memory limits, the render summary's facts).
 //
 //   seed_test_case [OUT.png]      (default: seed_test_case.png)
 //
@@ -8,21 +9,24 @@
 #include <exception>
 #include <iostream>
 #include <string>
+#include <utility>
 
-#include "../tests/seed_scene.h"
-#include "glint/image/image_writer.h"
-#include "glint/render/renderer.h"
-#include "glint/scene/scene.h"
+#include "glint/job/render_job.h"
+#include "glint/scene/seed_scene.h"
 
 int main(int argc, char** argv) {
-  const std::string output = argc > 1 ? argv[1] : "seed_test_case.png";
+  glint::RenderJobSpec job;
+  job.scene = "seed test case";  // what messages call the scene
+  job.sceneParts = glint::seed::testCaseParts(1000, 100);
+  job.output = argc > 1 ? argv[1] : "seed_test_case.png";
   try {
-    const glint::Scene scene(glint::seed::testCaseParts(1000, 100));
-    glint::RenderStats stats;
-    const glint::Film film = glint::render(scene, {}, &stats);
-    glint::writeImage(film, output, scene.image().encoding);
-    std::cout << "wrote " << output << " (" << film.width() << "×" << film.height() << ", "
-              << stats.rays.total() << " rays, " << stats.seconds << " s)\n";
+    const glint::RenderJobResult result = glint::runRenderJob(std::move(job));
+    std::cout << "wrote " << result.output.string() << " (" << result.scene.image.width << "×"
+              << result.scene.image.height << ", " << result.stats.rays.total() << " rays, "
+              << result.stats.seconds << " s)\n";
+  } catch (const glint::JobError& e) {
+    std::cerr << "seed_test_case: " << e.what() << "\n";
+    return e.exitCode();
   } catch (const std::exception& e) {
     std::cerr << "seed_test_case: " << e.what() << "\n";
     return 1;

@@ -21,7 +21,7 @@
 #include "glint/geometry/shape.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/scene.h"
-#include "seed_scene.h"
+#include "glint/scene/seed_scene.h"
 
 namespace glint {
 namespace {

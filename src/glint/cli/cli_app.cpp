@@ -2,21 +2,18 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
-#include <unistd.h>
 
 #include <oneapi/tbb/info.h>
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cctype>
 #include <charconv>
-#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <new>
 #include <optional>
@@ -25,26 +22,21 @@
 #include <string_view>
 #include <system_error>
 #include <utility>
-#include <variant>
 #include <vector>
 
 #include "glint/cli/progress_reporter.h"
 #include "glint/cli/signal_guard.h"
-#include "glint/factories/scene_loader.h"
-#include "glint/image/image_writer.h"
-#include "glint/job/checkpoint.h"
+#include "glint/job/job_error.h"
+#include "glint/job/render_job.h"
+#include "glint/job/scene_check.h"
 #include "glint/readers/diagnostics.h"
+#include "glint/render/film.h"
 #include "glint/render/renderer.h"
-#include "glint/scene/light.h"
 #include "glint/scene/scene.h"
 #include "glint/scene/scene_limits.h"
-#include "glint/scene/scene_overrides.h"
 
 namespace glint::cli {
 namespace {
-
-namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 // An error already worded for the user; `exitCode` is what the process returns. An empty message
 // means the details were printed already (scene diagnostics).
@@ -66,10 +58,6 @@ void emit(std::FILE* stream, std::string_view text) {
 
 void printError(std::string_view message) {
   emit(stderr, fmt::format("glint: error: {}\n", message));
-}
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 // The render command's arguments as typed. Numbers stay text until parseRequest, so every bad value
@@ -176,190 +164,57 @@ std::uint64_t parseMemorySize(const std::string& text) {
   return static_cast<std::uint64_t>(bytes);
 }
 
-void checkCrop(const PixelRegion& crop, int width, int height) {
-  if (0 <= crop.x0 && crop.x0 < crop.x1 && crop.x1 <= width && 0 <= crop.y0 && crop.y0 < crop.y1 &&
-      crop.y1 <= height)
-    return;
-  throw CliError(kExitBadInput,
-                 fmt::format("--crop {},{},{},{} does not fit the {}x{} image: it needs "
-                             "0 <= X0 < X1 <= {} and 0 <= Y0 < Y1 <= {}",
-                             crop.x0, crop.y0, crop.x1, crop.y1, width, height, width, height));
-}
-
-// The output path: given, or the scene file's name with ".png" in the current folder. Checked
-// before any work so that a typo does not cost a render.
-fs::path resolveOutput(const RenderArgs& args) {
-  fs::path out =
-      args.output.empty() ? fs::path(args.scene).stem().concat(".png") : fs::path(args.output);
-  if (!writerForPath(out)) {
-    const std::string extension = out.extension().string();
-    throw CliError(kExitBadInput,
-                   fmt::format("cannot write '{}': {}; use .png, .ppm or .exr", out.string(),
-                               extension.empty() ? std::string("the name has no extension")
-                                                 : "unknown image format '" + extension + "'"));
-  }
-  const fs::path folder = out.parent_path().empty() ? fs::path(".") : out.parent_path();
-  std::error_code error;
-  if (!fs::is_directory(folder, error))
-    throw CliError(kExitBadInput, fmt::format("cannot write '{}': the folder '{}' does not exist",
-                                              out.string(), folder.string()));
-  // Writing problems (exit 1) that can be seen now rather than after the render.
-  if (fs::is_directory(out, error))
-    throw CliError(kExitFailure, fmt::format("cannot write '{}': it is a folder", out.string()));
-  if (access(folder.c_str(), W_OK | X_OK) != 0)
-    throw CliError(kExitFailure, fmt::format("cannot write '{}': the folder '{}' is not writable",
-                                             out.string(), folder.string()));
-  return out;
-}
-
-// --- scene ----------------------------------------------------------------------------------
+// --- printing ------------------------------------------------------------------------------
 
 // Prints every diagnostic as "FILE:LINE:COL: message" (gcc style, so editors can jump to it).
 void printDiagnostics(const std::vector<Diagnostic>& diagnostics) {
   for (const Diagnostic& diagnostic : diagnostics) emit(stderr, diagnostic.format() + "\n");
 }
 
-LoadedScene load(const std::string& file, bool showWarnings,
-                 std::uint64_t memoryBudget = defaultImageMemoryBudget(),
-                 const SceneOverrides& overrides = {}) {
-  try {
-    LoadedScene loaded = loadScene(file, LoadOptions{memoryBudget, overrides});
-    if (showWarnings) printDiagnostics(loaded.warnings);
-    return loaded;
-  } catch (const SceneError& error) {
-    if (error.diagnostics().empty()) throw CliError(kExitBadInput, error.what());
-    printDiagnostics(error.diagnostics());
-    if (error.unreported() > 0)
-      emit(stderr, fmt::format("{}: {} more error{} not shown\n", file, error.unreported(),
-                               error.unreported() == 1 ? "" : "s"));
-    throw CliError(kExitBadInput, "");
-  }
-}
-
-// The image limits and memory budget (DESIGN.md §7) for the film that will be allocated, checked
-// again after the command line changed the image: a request refused as too large is a bad request
-// (exit 2), refused before any allocation.
-// `request` names the options that changed the image ("--width 70000"), empty for none.
-// `filmCopies`: films held at once (checkpointing keeps a copy of the finished tiles, resuming one
-// more of the checkpoint).
-void enforceImageLimits(const ImageSettings& image, const std::string& request,
-                        std::uint64_t memoryBudget = defaultImageMemoryBudget(),
-                        int filmCopies = 1) {
-  std::optional<std::string> refusal = checkImageSettings(image, memoryBudget);
-  const std::uint64_t film = filmBytes(image.width, image.height);
-  if (!refusal && filmCopies > 1 && film > memoryBudget / static_cast<std::uint64_t>(filmCopies)) {
-    refusal = fmt::format(
-        "an image of {} × {} pixels needs {} for its film and {} for checkpointing, more than the "
-        "memory budget of {}",
-        image.width, image.height, formatBytes(static_cast<double>(film)),
-        formatBytes(static_cast<double>(film) * static_cast<double>(filmCopies - 1)),
-        formatBytes(static_cast<double>(memoryBudget)));
-  }
-  if (refusal) {
-    throw CliError(kExitBadInput, request.empty()
-                                      ? fmt::format("request refused: {}", *refusal)
-                                      : fmt::format("{} refused: {}", request, *refusal));
-  }
-}
-
-// Scene construction (camera frame, BVH). The loader validates everything a file can get wrong,
-// so a refusal here is still the scene's fault: exit 2.
-Scene build(SceneParts parts, const std::string& file) {
-  try {
-    return Scene(std::move(parts));
-  } catch (const std::bad_alloc&) {
-    throw;
-  } catch (const std::exception& error) {
-    throw CliError(kExitBadInput, fmt::format("{}: {}", file, error.what()));
-  }
-}
-
 std::string formatPoint(const Point3& p) {
   return fmt::format("[{:g}, {:g}, {:g}]", p.x, p.y, p.z);
 }
 
-std::string formatBounds(const Scene& scene) {
-  const Bounds3 bounds = scene.aggregate().bounds();
-  if (bounds.isEmpty()) return "none (no bounded objects)";
-  return fmt::format("{} to {}", formatPoint(bounds.lo), formatPoint(bounds.hi));
+std::string boundsText(const SceneFacts& scene) {
+  if (scene.bounds.isEmpty()) return "none (no bounded objects)";
+  return fmt::format("{} to {}", formatPoint(scene.bounds.lo), formatPoint(scene.bounds.hi));
 }
-
-std::size_t unboundedCount(const Scene& scene) {
-  std::size_t count = 0;
-  for (const Primitive& primitive : scene.primitives()) count += primitive.isBounded() ? 0 : 1;
-  return count;
-}
-
-// Materials the scene defines; index 0 is the built-in default material.
-std::size_t materialCount(const Scene& scene) { return scene.materials().size() - 1; }
 
 // "3 (1 area) + ambient": the light sources, how many of them are area lights (soft shadows), and
 // whether the scene has ambient light.
-std::string lightsText(const Scene& scene) {
-  std::size_t area = 0;
-  for (const Light& light : scene.lights())
-    area += std::holds_alternative<AreaLight>(light) ? 1 : 0;
-  return fmt::format("{}{}{}", scene.lights().size(),
-                     area > 0 ? fmt::format(" ({} area)", area) : std::string(),
-                     isBlack(scene.ambient()) ? "" : " + ambient");
+std::string lightsText(const SceneFacts& scene) {
+  return fmt::format(
+      "{}{}{}", scene.lights,
+      scene.areaLights > 0 ? fmt::format(" ({} area)", scene.areaLights) : std::string(),
+      scene.ambient ? " + ambient" : "");
 }
 
 // "4 samples per pixel", or with adaptive sampling "4 to 64 samples per pixel (adaptive,
-// threshold 0.05)".
-std::string samplesText(const ImageSettings& image) {
+// threshold 0.05)": the samples every pixel takes (at least 4 when adaptive) to the most any may.
+std::string samplesText(const SceneFacts& scene) {
+  const ImageSettings& image = scene.image;
   if (!image.adaptive)
     return fmt::format("{} {} per pixel", image.samples, image.samples == 1 ? "sample" : "samples");
-  return fmt::format("{} to {} samples per pixel (adaptive, threshold {:g})", image.samples,
-                     image.adaptive->maxSamples, image.adaptive->threshold);
+  return fmt::format("{} to {} samples per pixel (adaptive, threshold {:g})",
+                     scene.samplesPerPixel.minimum, scene.samplesPerPixel.maximum,
+                     image.adaptive->threshold);
 }
 
 const char* plural(std::uint64_t n, const char* one, const char* many) {
   return n == 1 ? one : many;
 }
 
-// --- commands -------------------------------------------------------------------------------
-
-int runCheck(const std::string& file) {
-  LoadedScene loaded = load(file, true);
-  enforceImageLimits(loaded.parts.image, "");
-  const Scene scene = build(std::move(loaded.parts), file);
-  const ImageSettings& image = scene.image();
-  const std::size_t primitives = scene.primitives().size();
-  const std::size_t unbounded = unboundedCount(scene);
-  std::string text;
-  text += fmt::format("scene:     {}\n", scene.name().empty() ? "(unnamed)" : scene.name());
-  text += fmt::format("file:      {}\n", file);
-  text += fmt::format("image:     {}x{}, {}, {} encoding\n", image.width, image.height,
-                      samplesText(image), image.encoding == Encoding::Srgb ? "srgb" : "linear");
-  text += fmt::format("objects:   {} ({} bounded, {} unbounded)\n", primitives,
-                      primitives - unbounded, unbounded);
-  text += fmt::format("meshes:    {} ({} triangles)\n", scene.meshes().size(),
-                      scene.aggregate().triangleCount());
-  text += fmt::format("lights:    {}\n", lightsText(scene));
-  text += fmt::format("materials: {}\n", materialCount(scene));
-  text += fmt::format("bounds:    {}\n", formatBounds(scene));
-  emit(stdout, text);
-  return kExitSuccess;
-}
-
-std::string regionText(const Scene& scene, const std::optional<PixelRegion>& crop) {
-  std::string text = fmt::format("{}x{}", scene.image().width, scene.image().height);
+std::string regionText(const SceneFacts& scene, const std::optional<PixelRegion>& crop) {
+  std::string text = fmt::format("{}x{}", scene.image.width, scene.image.height);
   if (crop)
     text += fmt::format(", crop {},{},{},{} ({}x{})", crop->x0, crop->y0, crop->x1, crop->y1,
                         crop->width(), crop->height());
   return text;
 }
 
-// What a render did besides the rays: how many pixels it rendered (resumed tiles excluded), from
-// which checkpoint it resumed.
-struct RenderFacts {
-  std::uint64_t pixelsRendered = 0;
-  std::size_t tilesTotal = 0;
-  std::string resumedFrom;  // the --resume file, empty when not resuming
-};
-
-void printSummary(const fs::path& out, const Scene& scene, const std::optional<PixelRegion>& crop,
-                  const RenderStats& stats, const RenderFacts& facts) {
+void printSummary(const RenderJobResult& result) {
+  const SceneFacts& scene = result.scene;
+  const RenderStats& stats = result.stats;
   const RayCounts& rays = stats.rays;
   const std::string rate =
       stats.seconds > 0
@@ -368,14 +223,14 @@ void printSummary(const fs::path& out, const Scene& scene, const std::optional<P
   std::string text = fmt::format(
       "glint: wrote {} ({}) in {}; rays: {} camera, {} shadow, {} reflection, "
       "{} refraction; {}\n",
-      out.string(), regionText(scene, crop), formatDuration(stats.seconds), rays.camera,
-      rays.shadow, rays.reflection, rays.refraction, rate);
+      result.output.string(), regionText(scene, result.crop), formatDuration(stats.seconds),
+      rays.camera, rays.shadow, rays.reflection, rays.refraction, rate);
   // Adaptive sampling spends a varying number of samples per pixel; rays.camera counts them.
-  if (scene.image().adaptive && facts.pixelsRendered > 0)
+  if (scene.image.adaptive && result.pixelsRendered > 0)
     text +=
         fmt::format("glint: samples: {} ({:.2f} per pixel on average, {} to {})\n", rays.camera,
-                    static_cast<double>(rays.camera) / static_cast<double>(facts.pixelsRendered),
-                    scene.image().samples, scene.image().adaptive->maxSamples);
+                    static_cast<double>(rays.camera) / static_cast<double>(result.pixelsRendered),
+                    scene.samplesPerPixel.minimum, scene.samplesPerPixel.maximum);
   if (stats.nonFinite > 0) {
     text += fmt::format("glint: {} NaN/inf {} replaced by black", stats.nonFinite,
                         stats.nonFinite == 1 ? "sample" : "samples");
@@ -388,274 +243,170 @@ void printSummary(const fs::path& out, const Scene& scene, const std::optional<P
     text += fmt::format(
         "glint: {} of {} tiles resumed from '{}'; the time and counts above cover the {} tiles "
         "rendered now\n",
-        stats.tilesResumed, facts.tilesTotal, facts.resumedFrom,
-        facts.tilesTotal - stats.tilesResumed);
+        stats.tilesResumed, result.tilesTotal,
+        result.resumedFrom ? result.resumedFrom->string() : std::string(),
+        result.tilesTotal - stats.tilesResumed);
   emit(stderr, text);
 }
 
-struct Timings {
-  double load = 0, build = 0, write = 0;
-};
-
-void printStats(const Scene& scene, const std::optional<PixelRegion>& crop, int threads,
-                const RenderStats& stats, const Timings& timings, const RenderFacts& facts) {
-  const std::size_t primitives = scene.primitives().size();
-  const std::size_t unbounded = unboundedCount(scene);
-  const auto pixels = static_cast<double>(std::max<std::uint64_t>(facts.pixelsRendered, 1));
+void printStats(const RenderJobResult& result, int threads) {
+  const SceneFacts& scene = result.scene;
+  const RenderStats& stats = result.stats;
+  const RenderJobTimings& timings = result.timings;
+  const auto pixels = static_cast<double>(std::max<std::uint64_t>(result.pixelsRendered, 1));
   std::string text;
   text += fmt::format(
       "glint: scene: {} primitives ({} in the BVH, {} unbounded), {} materials, "
       "lights: {}\n",
-      primitives, primitives - unbounded, unbounded, materialCount(scene), lightsText(scene));
-  text += fmt::format("glint: bounds: {}\n", formatBounds(scene));
+      scene.objects, scene.objects - scene.unboundedObjects, scene.unboundedObjects,
+      scene.materials, lightsText(scene));
+  text += fmt::format("glint: bounds: {}\n", boundsText(scene));
   text += fmt::format("glint: image: {}, {}, {} {}, max depth {}, seed {}\n",
-                      regionText(scene, crop), samplesText(scene.image()), threads,
+                      regionText(scene, result.crop), samplesText(scene), threads,
                       plural(static_cast<std::uint64_t>(threads), "thread", "threads"),
-                      scene.render().maxDepth, scene.render().seed);
+                      scene.maxDepth, scene.seed);
   text += fmt::format("glint: rays: {} total, {:.1f} per pixel\n", stats.rays.total(),
                       static_cast<double>(stats.rays.total()) / pixels);
   text += fmt::format("glint: samples: {} total, {:.2f} per pixel\n", stats.rays.camera,
                       static_cast<double>(stats.rays.camera) / pixels);
   text += fmt::format("glint: time: load {}, build {}, render {}, write {}\n",
                       formatDuration(timings.load), formatDuration(timings.build),
-                      formatDuration(stats.seconds), formatDuration(timings.write));
+                      formatDuration(timings.render), formatDuration(timings.write));
   text += fmt::format("glint: non-finite samples: {}\n", stats.nonFinite);
   emit(stderr, text);
 }
 
-int interrupted(int signal) {
-  emit(stderr, "glint: interrupted\n");
-  return SignalGuard::exitCodeFor(signal);
+// Prints why the job failed: the scene's errors at their places, or one message.
+int reportJobError(const JobError& error, const std::string& sceneFile) {
+  if (!error.diagnostics().empty()) {
+    printDiagnostics(error.diagnostics());
+    if (error.unreported() > 0)
+      emit(stderr, fmt::format("{}: {} more error{} not shown\n", sceneFile, error.unreported(),
+                               error.unreported() == 1 ? "" : "s"));
+    return error.exitCode();
+  }
+  printError(error.what());
+  if (!error.savedCheckpoint().empty())
+    emit(stderr, fmt::format("glint: the finished render is saved in '{}' (write the image "
+                             "with --resume {})\n",
+                             error.savedCheckpoint().string(), error.savedCheckpoint().string()));
+  return error.exitCode();
 }
 
-// The typed request of a render command, checked as far as possible without the scene.
-struct RenderRequest {
-  SceneOverrides overrides;
-  std::string overrideText;  // "--width 70000", naming the options in a refusal message
-  int threads = 0;           // 0: all cores
-  std::optional<PixelRegion> crop;
-  std::uint64_t memoryBudget = defaultImageMemoryBudget();  // --max-memory
-};
+// --- commands -------------------------------------------------------------------------------
 
-RenderRequest parseRequest(const RenderArgs& args) {
-  RenderRequest request;
+int runCheck(const std::string& file) {
+  CheckOptions options;
+  options.warnings = printDiagnostics;
+  SceneFacts scene;
+  try {
+    scene = checkScene(file, options);
+  } catch (const JobError& error) {
+    return reportJobError(error, file);
+  }
+  std::string text;
+  text += fmt::format("scene:     {}\n", scene.name.empty() ? "(unnamed)" : scene.name);
+  text += fmt::format("file:      {}\n", file);
+  text +=
+      fmt::format("image:     {}x{}, {}, {} encoding\n", scene.image.width, scene.image.height,
+                  samplesText(scene), scene.image.encoding == Encoding::Srgb ? "srgb" : "linear");
+  text += fmt::format("objects:   {} ({} bounded, {} unbounded)\n", scene.objects,
+                      scene.objects - scene.unboundedObjects, scene.unboundedObjects);
+  text += fmt::format("meshes:    {} ({} triangles)\n", scene.meshes, scene.triangles);
+  text += fmt::format("lights:    {}\n", lightsText(scene));
+  text += fmt::format("materials: {}\n", scene.materials);
+  text += fmt::format("bounds:    {}\n", boundsText(scene));
+  emit(stdout, text);
+  return kExitSuccess;
+}
+
+// The render command's arguments as a job: every value checked as far as possible without the
+// scene. `--seed` is not named in refusals: it changes no size.
+RenderJobSpec parseRequest(const RenderArgs& args) {
+  RenderJobSpec spec;
+  spec.scene = args.scene;
+  spec.output = args.output;
   std::vector<std::string> named;
   if (args.width) {
-    request.overrides.width =
+    spec.overrides.width =
         static_cast<int>(parseWholeNumber("--width", *args.width, 1, kMaxImageSide));
     named.push_back("--width " + *args.width);
   }
   if (args.height) {
-    request.overrides.height =
+    spec.overrides.height =
         static_cast<int>(parseWholeNumber("--height", *args.height, 1, kMaxImageSide));
     named.push_back("--height " + *args.height);
   }
   if (args.samples) {
-    request.overrides.samples =
+    spec.overrides.samples =
         static_cast<int>(parseWholeNumber("--samples", *args.samples, 1, kMaxSamplesPerPixel));
     named.push_back("--samples " + *args.samples);
   }
-  if (args.seed) request.overrides.seed = parseSeed(*args.seed);
+  if (args.seed) spec.overrides.seed = parseSeed(*args.seed);
   if (args.threads)
-    request.threads =
-        static_cast<int>(parseWholeNumber("--threads", *args.threads, 1, kMaxThreads));
-  if (args.crop) request.crop = parseCrop(*args.crop);
+    spec.threads = static_cast<int>(parseWholeNumber("--threads", *args.threads, 1, kMaxThreads));
+  if (args.crop) spec.crop = parseCrop(*args.crop);
   if (args.maxMemory) {
-    request.memoryBudget = parseMemorySize(*args.maxMemory);
+    spec.memoryBudget = parseMemorySize(*args.maxMemory);
     named.push_back("--max-memory " + *args.maxMemory);
   }
-  request.overrideText = fmt::format("{}", fmt::join(named, " "));
-  return request;
+  spec.requestText = fmt::format("{}", fmt::join(named, " "));
+  if (args.checkpoint) spec.checkpoint = std::filesystem::path(*args.checkpoint);
+  if (args.resume) spec.resume = std::filesystem::path(*args.resume);
+  return spec;
 }
 
-// The checkpoint file a render writes: --checkpoint, or else the --resume file (a resumed render
-// keeps checkpointing, so it can be interrupted again). Checked before any work, like the output.
-std::optional<fs::path> resolveCheckpoint(const RenderArgs& args, const fs::path& out) {
-  if (!args.checkpoint && !args.resume) return std::nullopt;
-  const fs::path path(args.checkpoint ? *args.checkpoint : *args.resume);
-  if (path.empty()) throw CliError(kExitBadInput, "--checkpoint needs a file name");
-  std::error_code error;
-  if (fs::equivalent(path, out, error) || path.lexically_normal() == out.lexically_normal())
-    throw CliError(kExitBadInput,
-                   fmt::format("the checkpoint '{}' cannot be the output image", path.string()));
-  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  if (!fs::is_directory(folder, error))
-    throw CliError(kExitBadInput,
-                   fmt::format("cannot write checkpoint '{}': the folder '{}' does not exist",
-                               path.string(), folder.string()));
-  if (fs::is_directory(path, error))
-    throw CliError(kExitBadInput,
-                   fmt::format("cannot write checkpoint '{}': it is a folder", path.string()));
-  if (access(folder.c_str(), W_OK | X_OK) != 0)
-    throw CliError(kExitFailure,
-                   fmt::format("cannot write checkpoint '{}': the folder '{}' is not writable",
-                               path.string(), folder.string()));
-  // Starting afresh over an existing checkpoint would throw away the work saved in it.
-  const bool continuesIt = args.resume && fs::equivalent(path, fs::path(*args.resume), error);
-  if (!continuesIt && fs::exists(path, error))
-    throw CliError(kExitBadInput,
-                   fmt::format("the checkpoint '{}' already exists; continue it with --resume {}, "
-                               "or delete it to start over",
-                               path.string(), path.string()));
-  return path;
-}
-
-std::string readWholeFile(const std::string& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (!in && !in.eof())
-    throw CliError(kExitFailure, fmt::format("cannot read '{}' again to fingerprint it", file));
-  return bytes;
+int reportInterrupted(const RenderJobResult& result) {
+  if (result.checkpointSavedTo) {
+    const std::string path = result.checkpointSavedTo->string();
+    emit(stderr, fmt::format("glint: interrupted; {} of {} tiles saved to '{}' (continue with "
+                             "--resume {})\n",
+                             result.tilesSaved, result.tilesTotal, path, path));
+  } else if (!result.checkpointSaveError.empty()) {
+    emit(stderr, fmt::format("glint: interrupted; {}\n", result.checkpointSaveError));
+  } else {
+    emit(stderr, "glint: interrupted\n");
+  }
+  return SignalGuard::exitCodeFor(result.signal != 0 ? result.signal : SIGINT);
 }
 
 int runRender(const RenderArgs& args, SignalGuard& signals) {
-  const RenderRequest request = parseRequest(args);
-  const std::optional<PixelRegion>& crop = request.crop;
-  const fs::path out = resolveOutput(args);
-  const std::optional<fs::path> checkpointPath = resolveCheckpoint(args, out);
-
-  Timings timings;
-  auto phase = Clock::now();
-  LoadedScene loaded = load(args.scene, !args.quiet, request.memoryBudget, request.overrides);
-  ImageSettings allocated = loaded.parts.image;
-  if (crop) {
-    checkCrop(*crop, loaded.parts.image.width, loaded.parts.image.height);
-    // The film covers only the crop, so a huge image can still be rendered piece by piece.
-    allocated.width = crop->width();
-    allocated.height = crop->height();
-  }
-  const int filmCopies = 1 + (checkpointPath ? 1 : 0) + (args.resume ? 1 : 0);
-  enforceImageLimits(allocated, request.overrideText, request.memoryBudget, filmCopies);
-  timings.load = secondsSince(phase);
-  if (signals.receivedSignal() != 0) return interrupted(signals.receivedSignal());
-
-  phase = Clock::now();
-  const Scene scene = build(std::move(loaded.parts), args.scene);
-  timings.build = secondsSince(phase);
-  if (signals.receivedSignal() != 0) return interrupted(signals.receivedSignal());
-
-  RenderOptions options;
-  options.threads = request.threads;
-  options.crop = crop;
-  options.cancel = &signals.cancelFlag();
-  const PixelRegion region =
-      crop.value_or(PixelRegion{0, 0, scene.image().width, scene.image().height});
-  const std::vector<PixelRegion> tiles = tileRegions(region, options.tileSize);
-
-  // Checkpointing: the fingerprint of this render, the checkpoint it continues, the collector.
-  std::optional<Checkpoint> resumed;
-  std::optional<CheckpointCollector> collector;
-  if (checkpointPath) {
-    const CheckpointSettings settings = checkpointSettingsFor(scene, region, options.tileSize);
-    const std::uint64_t fingerprint = renderFingerprint(readWholeFile(args.scene), scene, settings);
-    if (args.resume) {
-      try {
-        resumed = readCheckpoint(*args.resume, request.memoryBudget);
-      } catch (const CheckpointError& error) {
-        throw CliError(kExitBadInput, fmt::format("cannot resume: {}", error.what()));
-      }
-      if (const std::optional<std::string> mismatch =
-              checkpointMismatch(*resumed, fingerprint, settings))
-        throw CliError(kExitBadInput,
-                       fmt::format("cannot resume from '{}': {}; render with the same scene and "
-                                   "options, or delete it to start over",
-                                   *args.resume, *mismatch));
-      options.resumeFilm = &resumed->film;
-      options.resumeTiles = &resumed->tiles;
-    }
-    collector.emplace(*checkpointPath, resumed ? *resumed : emptyCheckpoint(fingerprint, settings));
-  }
-  if (signals.receivedSignal() != 0) return interrupted(signals.receivedSignal());
+  RenderJobSpec spec = parseRequest(args);
+  spec.cancel = &signals.cancelFlag();
+  spec.cancelSignal = &signals.signalNumber();
+  const int threads = spec.threads > 0 ? spec.threads : tbb::info::default_concurrency();
 
   ProgressReporter progress(
       args.quiet ? ProgressReporter::Style::Silent : ProgressReporter::styleFor(stderr), stderr);
-  options.progress = [&progress](std::size_t done, std::size_t total) {
+  RenderJobEvents events;
+  if (!args.quiet) events.sceneWarnings = printDiagnostics;
+  events.renderStarting = [&progress](std::size_t resumed, std::size_t) {
+    progress.start(resumed);
+  };
+  events.progress = [&progress](std::size_t done, std::size_t total) {
     progress.update(done, total);
   };
-  bool saveFailed = false;  // warn once, not at every periodic save
-  if (collector) {
-    options.tileFinished = [&](std::size_t tile, const Film& film) {
-      collector->addTile(tile, film);
-      // After a stop request the checkpoint is saved once, when the render has returned.
-      if (!collector->saveDue() || signals.receivedSignal() != 0) return;
-      // A second signal must not end the process with a temporary file left behind.
-      signals.setCommitting(true);
-      try {
-        collector->save();
-      } catch (const CheckpointError& error) {
-        if (!saveFailed)
-          emit(stderr, fmt::format("\nglint: warning: {}; the render goes on\n", error.what()));
-        saveFailed = true;
-      }
-      signals.setCommitting(false);
-    };
-  }
-  RenderStats stats;
-  progress.start(resumed ? resumed->finishedTiles() : 0);
-  Film film = render(scene, options, &stats);
-  progress.finish();
-  // A signal that came after the last tile still means "stop": nothing is written.
-  if (stats.cancelled || signals.receivedSignal() != 0) {
-    const int signal = signals.receivedSignal() != 0 ? signals.receivedSignal() : SIGINT;
-    if (!collector) return interrupted(signal);
-    signals.setCommitting(true);
-    try {
-      collector->save();
-      emit(stderr, fmt::format("glint: interrupted; {} of {} tiles saved to '{}' (continue with "
-                               "--resume {})\n",
-                               collector->checkpoint().finishedTiles(), tiles.size(),
-                               checkpointPath->string(), checkpointPath->string()));
-    } catch (const CheckpointError& error) {
-      emit(stderr, fmt::format("glint: interrupted; {}\n", error.what()));
-    }
-    return SignalGuard::exitCodeFor(signal);
-  }
+  events.renderEnded = [&progress]() { progress.finish(); };
+  events.checkpointSaveFailed = [](const std::string& reason) {
+    emit(stderr, fmt::format("\nglint: warning: {}; the render goes on\n", reason));
+  };
+  // A second signal must not end the process with a temporary file left behind.
+  events.committing = [&signals](bool committing) { signals.setCommitting(committing); };
 
-  // From here on the image is complete; the writer commits it atomically (temporary file, rename)
-  // and a second signal no longer ends the process halfway through.
-  signals.setCommitting(true);
-  phase = Clock::now();
+  RenderJobResult result;
   try {
-    writeImage(film, out, scene.image().encoding);
-  } catch (const ImageWriteError& error) {
-    // Keep the finished render: a --resume after fixing the output only writes the image.
-    if (collector) {
-      try {
-        collector->save();
-        printError(error.what());
-        emit(stderr, fmt::format("glint: the finished render is saved in '{}' (write the image "
-                                 "with --resume {})\n",
-                                 checkpointPath->string(), checkpointPath->string()));
-        return kExitFailure;
-      } catch (const CheckpointError&) {
-        // Report the write failure itself.
-      }
-    }
-    throw CliError(kExitFailure, error.what());
+    result = runRenderJob(std::move(spec), events);
+  } catch (const JobError& error) {
+    return reportJobError(error, args.scene);
   }
-  timings.write = secondsSince(phase);
-  // The image is complete, so its checkpoint has served its purpose.
-  if (checkpointPath) {
-    std::error_code error;
-    fs::remove(*checkpointPath, error);
-    if (error && !args.quiet)
-      emit(stderr, fmt::format("glint: warning: cannot remove the checkpoint '{}': {}\n",
-                               checkpointPath->string(), error.message()));
-  }
-
+  if (result.outcome == RenderJobResult::Outcome::Interrupted) return reportInterrupted(result);
+  if (!result.checkpointRemovalError.empty() && !args.quiet)
+    emit(stderr, fmt::format("glint: warning: cannot remove the checkpoint '{}': {}\n",
+                             args.checkpoint ? *args.checkpoint : *args.resume,
+                             result.checkpointRemovalError));
   if (!args.quiet) {
-    RenderFacts facts;
-    facts.tilesTotal = tiles.size();
-    for (std::size_t i = 0; i < tiles.size(); ++i)
-      if (!resumed || !resumed->tiles[i])
-        facts.pixelsRendered += static_cast<std::uint64_t>(tiles[i].width()) *
-                                static_cast<std::uint64_t>(tiles[i].height());
-    if (args.resume) facts.resumedFrom = *args.resume;
-    printSummary(out, scene, crop, stats, facts);
-    if (args.stats) {
-      const int threads = request.threads > 0 ? request.threads : tbb::info::default_concurrency();
-      printStats(scene, crop, threads, stats, timings, facts);
-    }
+    printSummary(result);
+    if (args.stats) printStats(result, threads);
   }
   return kExitSuccess;
 }
@@ -746,8 +497,8 @@ int runCommandLine(int argc, char** argv) {
   // Set after the subcommands exist: CLI11 copies a parent's footer into subcommands made later.
   const std::string exitStatus =
       "Exit status: 0 success; 1 failure while rendering or writing; 2 bad arguments, a bad scene, "
-      "a request refused as too large or a checkpoint that does not match; 130/143 interrupted "
-      "by SIGINT/SIGTERM (no output written; the --checkpoint file saved).";
+      "a request refused as too large or a checkpoint that does not match; 130/143/129 "
+      "interrupted by SIGINT/SIGTERM/SIGHUP (no output written; the --checkpoint file saved).";
   app.footer(
       "Examples:\n  glint render scene.yaml -o scene.png --width 800\n"
       "  glint render scene.yaml --crop 0,0,400,300 -o top-left.ppm\n"

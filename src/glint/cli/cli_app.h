@@ -5,7 +5,7 @@
 namespace glint::cli {
 
 // Exit statuses of the glint command (DESIGN.md §6, §7). An interrupted run exits with
-// 128 + the signal number (130 for SIGINT, 143 for SIGTERM).
+// 128 + the signal number (130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP).
 inline constexpr int kExitSuccess = 0;
 inline constexpr int kExitFailure = 1;  // failure while rendering or writing
 inline constexpr int kExitBadInput =

@@ -14,8 +14,9 @@ std::atomic<int> gSignal{0};
 std::atomic<bool> gCommitting{false};
 static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free);
 
-constexpr std::array<int, 2> kHandledSignals{SIGINT, SIGTERM};
-std::array<struct sigaction, 2> gPrevious{};
+constexpr std::array<int, 3> kHandledSignals{SIGINT, SIGTERM, SIGHUP};
+std::array<struct sigaction, kHandledSignals.size()> gPrevious{};
+struct sigaction gPreviousPipe {};
 
 extern "C" void onStopSignal(int signal) {
   int expected = 0;
@@ -43,17 +44,22 @@ SignalGuard::SignalGuard() {
   for (std::size_t i = 0; i < kHandledSignals.size(); ++i) {
     sigaction(kHandledSignals[i], &action, &gPrevious[i]);
   }
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGPIPE, &ignore, &gPreviousPipe);
 }
 
 SignalGuard::~SignalGuard() {
   for (std::size_t i = 0; i < kHandledSignals.size(); ++i) {
     sigaction(kHandledSignals[i], &gPrevious[i], nullptr);
   }
+  sigaction(SIGPIPE, &gPreviousPipe, nullptr);
 }
 
 const std::atomic<bool>& SignalGuard::cancelFlag() const { return gCancel; }
 
-int SignalGuard::receivedSignal() const { return gSignal.load(); }
+const std::atomic<int>& SignalGuard::signalNumber() const { return gSignal; }
 
 void SignalGuard::setCommitting(bool committing) { gCommitting.store(committing); }
 

@@ -1,4 +1,5 @@
-// PNG (libpng), PPM (P6) and OpenEXR writers behind one atomic write-then-rename policy.
+// PNG (libpng), PPM (P6) and OpenEXR writers behind one atomic write-then-rename policy, each
+// writing row by row so that a cancel stops it within a row.
 #include "glint/image/image_writer.h"
 
 #include <ImfChannelList.h>
@@ -6,10 +7,8 @@
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
 #include <png.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -17,9 +16,13 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <optional>
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include "glint/core/atomic_file.h"
+#include "glint/core/cancel.h"
 
 namespace glint {
 
@@ -47,11 +50,12 @@ std::string quoted(const std::filesystem::path& path) { return "'" + path.string
   throw ImageWriteError("cannot write " + quoted(target) + ": " + reason);
 }
 
-// A temporary file beside the target, created exclusively, removed on destruction unless committed
-// by renaming it over the target. This is what makes every write all-or-nothing.
-class TemporaryFile {
+// The temporary file of one write (core/atomic_file.h), with the writers' error messages: removed
+// on destruction unless committed by renaming it over the target. This is what makes every write
+// all-or-nothing.
+class TemporaryImage {
  public:
-  explicit TemporaryFile(const std::filesystem::path& target) : target_(target) {
+  explicit TemporaryImage(const std::filesystem::path& target) : target_(target) {
     const std::filesystem::path folder =
         target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
     std::error_code ec;
@@ -60,79 +64,67 @@ class TemporaryFile {
       fail(target, "folder " + quoted(folder) + " does not exist");
     if (!std::filesystem::is_directory(status)) fail(target, quoted(folder) + " is not a folder");
     if (!target.has_filename()) fail(target, "the path names no file");
-
-    static std::atomic<unsigned long> counter{0};
-    // Exclusive creation ("x"): a name collision (another process, a stale file) takes the next n.
-    for (int attempt = 0; attempt < 100; ++attempt) {
-      const std::string name = "." + target.filename().string() + ".tmp-" +
-                               std::to_string(::getpid()) + "-" + std::to_string(counter++);
-      path_ = target.has_parent_path() ? target.parent_path() / name : std::filesystem::path(name);
-      file_ = std::fopen(path_.c_str(), "wbx");
-      if (file_ || errno != EEXIST) break;
-    }
-    if (!file_) fail(target, std::strerror(errno));
-  }
-  TemporaryFile(const TemporaryFile&) = delete;
-  TemporaryFile& operator=(const TemporaryFile&) = delete;
-  ~TemporaryFile() {
-    if (file_) std::fclose(file_);
-    if (!committed_) {
-      std::error_code ignored;
-      std::filesystem::remove(path_, ignored);
+    try {
+      file_.emplace(target);
+    } catch (const std::system_error& error) {
+      fail(target, error.code().message());
     }
   }
 
-  std::FILE* stream() const { return file_; }
-  const std::filesystem::path& path() const { return path_; }
+  std::FILE* stream() {
+    try {
+      return file_->stream();
+    } catch (const std::system_error& error) {
+      fail(target_, error.code().message());
+    }
+  }
+  const std::filesystem::path& path() const { return file_->temporaryPath(); }
 
-  // Closes the stream (without writing more through it).
+  // Closes the file (without writing more through it); it stays until commit or destruction.
   void close() {
-    if (!file_) return;
-    const bool failed = std::ferror(file_) != 0;
-    const int savedErrno = errno;
-    const int closed = std::fclose(file_);
-    file_ = nullptr;
-    if (failed) fail(target_, std::string("write error: ") + std::strerror(savedErrno));
-    if (closed != 0) fail(target_, std::string("write error: ") + std::strerror(errno));
+    try {
+      file_->close();
+    } catch (const std::system_error& error) {
+      fail(target_, "write error: " + error.code().message());
+    }
   }
 
   // Flushes, closes and atomically replaces the target.
   void commit() {
     close();
-    std::error_code ec;
-    std::filesystem::rename(path_, target_, ec);
-    if (ec) fail(target_, ec.message());
-    committed_ = true;
+    try {
+      file_->commit();
+    } catch (const std::system_error& error) {
+      fail(target_, error.code().message());
+    }
   }
 
  private:
   std::filesystem::path target_;
-  std::filesystem::path path_;
-  std::FILE* file_ = nullptr;
-  bool committed_ = false;
+  std::optional<AtomicFile> file_;
 };
 
 void requireNonEmpty(const Film& film, const std::filesystem::path& path) {
   if (film.width() <= 0 || film.height() <= 0) fail(path, "the image is empty");
 }
 
-// Interleaved 8-bit RGB rows, top row first.
-std::vector<std::uint8_t> encodeRgb8(const Film& film, Encoding encoding) {
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(film.width()) * film.height() * 3);
-  std::uint8_t* out = bytes.data();
-  for (const Color& c : film.pixels()) {  // row-major, top row first: the file's order
+// Row `row` of the film as interleaved 8-bit RGB into `out` (3 · width bytes).
+void encodeRow(const Film& film, int row, Encoding encoding, std::uint8_t* out) {
+  for (int x = 0; x < film.width(); ++x) {
+    const Color& c = film.at(x, row);
     *out++ = encodeChannel(c.r, encoding);
     *out++ = encodeChannel(c.g, encoding);
     *out++ = encodeChannel(c.b, encoding);
   }
-  return bytes;
 }
 
 // libpng reports errors by longjmp; the message is kept here. The setjmp frame below holds only
-// trivially destructible locals, so the jump skips no destructor.
+// trivially destructible locals, so the jump skips no destructor; a callback's exception is kept
+// here too, so that it never unwinds through libpng's frames.
 struct PngErrorState {
   std::jmp_buf jump;
   char message[256];
+  std::exception_ptr callbackError;
 };
 
 void pngError(png_structp png, png_const_charp message) {
@@ -143,87 +135,124 @@ void pngError(png_structp png, png_const_charp message) {
 
 void pngWarning(png_structp, png_const_charp) {}
 
-// Returns false (with state.message set) when libpng fails.
-bool writePngStream(std::FILE* file, const std::uint8_t* rgb, png_uint_32 width, png_uint_32 height,
-                    bool srgb, PngErrorState& state) {
+enum class PngOutcome { Written, Failed, Cancelled };
+
+// Encodes and writes the film row by row through `row` (3 · width bytes), polling the cancel flag
+// before each. Failed: state.message says why.
+PngOutcome writePngStream(std::FILE* file, const Film& film, Encoding encoding, std::uint8_t* row,
+                          const WriteControl& control, PngErrorState& state) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &state, pngError, pngWarning);
   if (!png) {
     std::snprintf(state.message, sizeof state.message, "out of memory");
-    return false;
+    return PngOutcome::Failed;
   }
   png_infop info = png_create_info_struct(png);
   if (!info) {
     png_destroy_write_struct(&png, nullptr);
     std::snprintf(state.message, sizeof state.message, "out of memory");
-    return false;
+    return PngOutcome::Failed;
   }
   if (setjmp(state.jump)) {
     png_destroy_write_struct(&png, &info);
-    return false;
+    return PngOutcome::Failed;
   }
+  const auto width = static_cast<png_uint_32>(film.width());
+  const int height = film.height();
   png_init_io(png, file);
-  png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_IHDR(png, info, width, static_cast<png_uint_32>(height), 8, PNG_COLOR_TYPE_RGB,
+               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   // sRGB-encoded codes say so; linear codes carry no colour-space chunk at all (no gAMA).
-  if (srgb) png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  if (encoding == Encoding::Srgb) png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
   png_write_info(png, info);
-  for (png_uint_32 row = 0; row < height; ++row) {
-    png_write_row(png, rgb + static_cast<std::size_t>(row) * width * 3);
+  for (int y = 0; y < height; ++y) {
+    if (isCancelled(control.cancel)) {
+      png_destroy_write_struct(&png, &info);
+      return PngOutcome::Cancelled;
+    }
+    encodeRow(film, y, encoding, row);
+    png_write_row(png, row);
+    if (control.rowWritten) {
+      try {
+        control.rowWritten(y + 1, height);
+      } catch (...) {
+        state.callbackError = std::current_exception();
+        png_destroy_write_struct(&png, &info);
+        return PngOutcome::Failed;
+      }
+    }
   }
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  return true;
+  return PngOutcome::Written;
 }
 
 class PngWriter final : public ImageWriter {
  public:
-  void write(const Film& film, const std::filesystem::path& path,
-             Encoding encoding) const override {
+  void write(const Film& film, const std::filesystem::path& path, Encoding encoding,
+             const WriteControl& control) const override {
     requireNonEmpty(film, path);
-    const std::vector<std::uint8_t> rgb = encodeRgb8(film, encoding);
-    TemporaryFile temp(path);
+    throwIfCancelled(control.cancel);
+    std::vector<std::uint8_t> row(static_cast<std::size_t>(film.width()) * 3);
+    TemporaryImage temp(path);
     PngErrorState state{};
-    if (!writePngStream(temp.stream(), rgb.data(), static_cast<png_uint_32>(film.width()),
-                        static_cast<png_uint_32>(film.height()), encoding == Encoding::Srgb,
-                        state)) {
-      fail(path, std::string("PNG error: ") + state.message);
-    }
+    const PngOutcome outcome =
+        writePngStream(temp.stream(), film, encoding, row.data(), control, state);
+    if (state.callbackError) std::rethrow_exception(state.callbackError);
+    if (outcome == PngOutcome::Cancelled) throw Cancelled();
+    if (outcome == PngOutcome::Failed) fail(path, std::string("PNG error: ") + state.message);
     temp.commit();
   }
 };
 
 class PpmWriter final : public ImageWriter {
  public:
-  void write(const Film& film, const std::filesystem::path& path,
-             Encoding encoding) const override {
+  void write(const Film& film, const std::filesystem::path& path, Encoding encoding,
+             const WriteControl& control) const override {
     requireNonEmpty(film, path);
-    const std::vector<std::uint8_t> rgb = encodeRgb8(film, encoding);
-    TemporaryFile temp(path);
+    throwIfCancelled(control.cancel);
+    std::vector<std::uint8_t> row(static_cast<std::size_t>(film.width()) * 3);
+    TemporaryImage temp(path);
     const std::string header =
         "P6\n" + std::to_string(film.width()) + " " + std::to_string(film.height()) + "\n255\n";
     std::fwrite(header.data(), 1, header.size(), temp.stream());
-    std::fwrite(rgb.data(), 1, rgb.size(), temp.stream());
+    for (int y = 0; y < film.height(); ++y) {
+      throwIfCancelled(control.cancel);
+      encodeRow(film, y, encoding, row.data());
+      std::fwrite(row.data(), 1, row.size(), temp.stream());
+      if (control.rowWritten) control.rowWritten(y + 1, film.height());
+    }
     temp.commit();
   }
 };
 
+// Rows OpenEXR gets per writePixels call: the cancel flag is polled between calls. A multiple of
+// 16, the scanline block of its default ZIP compression, so no block is compressed twice.
+constexpr int kExrRowsPerCall = 64;
+
 // Linear half of the pipeline: the film's values as 32-bit floats, unclamped, no encoding.
 class ExrWriter final : public ImageWriter {
  public:
-  void write(const Film& film, const std::filesystem::path& path, Encoding) const override {
+  void write(const Film& film, const std::filesystem::path& path, Encoding,
+             const WriteControl& control) const override {
     requireNonEmpty(film, path);
+    throwIfCancelled(control.cancel);
     const int width = film.width();
     const int height = film.height();
     const std::size_t count = static_cast<std::size_t>(width) * height;
     std::vector<float> red(count), green(count), blue(count);
-    for (std::size_t i = 0; i < count; ++i) {
-      const Color& c = film.pixels()[i];
-      red[i] = static_cast<float>(c.r);
-      green[i] = static_cast<float>(c.g);
-      blue[i] = static_cast<float>(c.b);
+    for (int y = 0; y < height; ++y) {
+      throwIfCancelled(control.cancel);
+      const std::size_t first = static_cast<std::size_t>(y) * width;
+      for (std::size_t i = first; i < first + static_cast<std::size_t>(width); ++i) {
+        const Color& c = film.pixels()[i];
+        red[i] = static_cast<float>(c.r);
+        green[i] = static_cast<float>(c.g);
+        blue[i] = static_cast<float>(c.b);
+      }
     }
-    TemporaryFile temp(path);
-    temp.close();  // reserves the unique name; OpenEXR reopens it by path
+    TemporaryImage temp(path);
+    temp.close();                      // reserves the unique name; OpenEXR reopens it by path
+    std::exception_ptr callbackError;  // rethrown as it is, not as an OpenEXR error
     try {
       Imf::Header header(width, height);
       header.channels().insert("R", Imf::Channel(Imf::FLOAT));
@@ -240,10 +269,25 @@ class ExrWriter final : public ImageWriter {
                    Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(blue.data()), xStride, yStride));
       Imf::OutputFile out(temp.path().c_str(), header);
       out.setFrameBuffer(frame);
-      out.writePixels(height);
+      // writePixels(n) writes the next n rows of the frame buffer.
+      for (int y = 0; y < height; y += kExrRowsPerCall) {
+        throwIfCancelled(control.cancel);
+        const int rows = std::min(kExrRowsPerCall, height - y);
+        out.writePixels(rows);
+        if (!control.rowWritten) continue;
+        try {
+          control.rowWritten(y + rows, height);
+        } catch (...) {
+          callbackError = std::current_exception();
+          break;
+        }
+      }
+    } catch (const Cancelled&) {
+      throw;
     } catch (const std::exception& e) {
       fail(path, std::string("OpenEXR error: ") + e.what());
     }
+    if (callbackError) std::rethrow_exception(callbackError);
     temp.commit();
   }
 };
@@ -265,7 +309,8 @@ std::unique_ptr<ImageWriter> writerForPath(const std::filesystem::path& path) {
   return nullptr;
 }
 
-void writeImage(const Film& film, const std::filesystem::path& path, Encoding encoding) {
+void writeImage(const Film& film, const std::filesystem::path& path, Encoding encoding,
+                const WriteControl& control) {
   const std::unique_ptr<ImageWriter> writer = writerForPath(path);
   if (!writer) {
     const std::string ext = path.extension().string();
@@ -273,7 +318,7 @@ void writeImage(const Film& film, const std::filesystem::path& path, Encoding en
          (ext.empty() ? std::string("no file extension") : "unknown file extension '" + ext + "'") +
              " (expected .png, .ppm or .exr)");
   }
-  writer->write(film, path, encoding);
+  writer->write(film, path, encoding, control);
 }
 
 }  // namespace glint

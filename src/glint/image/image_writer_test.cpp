@@ -9,6 +9,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <climits>
 #include <cmath>
 #include <csetjmp>
 #include <cstdint>
@@ -19,6 +21,9 @@
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "glint/core/atomic_file.h"
+#include "glint/core/cancel.h"
 
 namespace glint {
 namespace {
@@ -347,6 +352,88 @@ TEST_F(ImageWriterTest, RelativePathWritesIntoCurrentFolder) {
   fs::current_path(previous);
   EXPECT_TRUE(fs::exists(dir_ / "relative.ppm"));
   EXPECT_EQ(filesExcept("relative.ppm"), std::vector<std::string>{});
+}
+
+// A target name of NAME_MAX bytes is legal, so its image must be writable: the temporary file's
+// name may not grow with it.
+TEST_F(ImageWriterTest, TheLongestLegalFileNameIsWritten) {
+  for (const char* extension : {".png", ".ppm", ".exr"}) {
+    const fs::path path = dir_ / (std::string(NAME_MAX - 4, 'n') + extension);
+    writeImage(testFilm(), path, Encoding::Srgb);
+    EXPECT_TRUE(fs::exists(path)) << extension;
+    fs::remove(path);
+  }
+  EXPECT_TRUE(filesExcept().empty());
+}
+
+// A film tall enough for several OpenEXR write calls (64 rows each).
+Film tallFilm() {
+  Film film(5, 200, PixelRegion{0, 0, 5, 200});
+  for (int y = 0; y < 200; ++y)
+    for (int x = 0; x < 5; ++x) film.at(x, y) = Color(x * 0.2, y / 200.0, 0.5);
+  return film;
+}
+
+TEST_F(ImageWriterTest, ACancelledWriteStopsWithinARowAndLeavesNothing) {
+  const Film film = tallFilm();
+  for (const char* name : {"image.png", "image.ppm", "image.exr"}) {
+    const fs::path path = dir_ / name;
+    std::ofstream(path, std::ios::binary) << "previous image";
+    std::atomic<bool> cancel{false};
+    int rowsWhenCancelled = 0;
+    int rowsAfter = 0;
+    WriteControl control;
+    control.cancel = &cancel;
+    control.rowWritten = [&](int rows, int total) {
+      EXPECT_EQ(total, 200);
+      // The temporary file exists beside the target while the image is written.
+      std::vector<std::string> others = filesExcept(name);
+      EXPECT_EQ(others.size(), 1u) << name;
+      if (others.size() == 1) {
+        EXPECT_TRUE(isTemporaryFileName(others[0])) << others[0];
+      }
+      if (cancel.load()) ++rowsAfter;
+      if (rows >= 3 && !cancel.load()) {
+        rowsWhenCancelled = rows;
+        cancel.store(true);
+      }
+    };
+    EXPECT_THROW(writeImage(film, path, Encoding::Srgb, control), Cancelled) << name;
+    EXPECT_GT(rowsWhenCancelled, 0) << name;
+    EXPECT_LT(rowsWhenCancelled, 200) << name;
+    EXPECT_EQ(rowsAfter, 0) << name << ": rows were written after the cancel";
+    std::ifstream in(path, std::ios::binary);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "previous image") << name;
+    EXPECT_EQ(filesExcept(name), std::vector<std::string>{}) << name;
+    fs::remove(path);
+  }
+}
+
+TEST_F(ImageWriterTest, AWriteCancelledBeforeItStartsCreatesNoFile) {
+  std::atomic<bool> cancel{true};
+  for (const char* name : {"image.png", "image.ppm", "image.exr"}) {
+    EXPECT_THROW(writeImage(testFilm(), dir_ / name, Encoding::Srgb, WriteControl{&cancel, {}}),
+                 Cancelled)
+        << name;
+  }
+  EXPECT_TRUE(filesExcept().empty());
+}
+
+TEST_F(ImageWriterTest, RowByRowWritingReportsEveryRowOnce) {
+  const Film film = tallFilm();
+  for (const char* name : {"rows.png", "rows.ppm", "rows.exr"}) {
+    int last = 0;
+    WriteControl control;
+    control.rowWritten = [&](int rows, int total) {
+      EXPECT_GT(rows, last);
+      EXPECT_EQ(total, 200);
+      last = rows;
+    };
+    writeImage(film, dir_ / name, Encoding::Linear, control);
+    EXPECT_EQ(last, 200) << name;
+  }
+  const PngContents png = readPng(dir_ / "rows.png");
+  EXPECT_EQ(png.rgb, expectedBytes(film, Encoding::Linear));
 }
 
 }  // namespace

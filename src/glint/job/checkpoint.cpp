@@ -1,18 +1,17 @@
 #include "glint/job/checkpoint.h"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <bit>
 #include <cerrno>
-#include <cstdlib>
-#include <cstring>
-#include <fstream>
-#include <iterator>
 #include <system_error>
 #include <utility>
 
+#include "glint/core/atomic_file.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/scene_limits.h"
 
@@ -95,6 +94,27 @@ void copyTile(const PixelRegion& tile, const Film& from, Film& to) {
   for (int y = tile.y0; y < tile.y1; ++y)
     for (int x = tile.x0; x < tile.x1; ++x)
       to.at(x - region.x0, y - region.y0) = from.at(x - region.x0, y - region.y0);
+}
+
+// Closes a POSIX file descriptor when it goes out of scope.
+struct FileDescriptor {
+  explicit FileDescriptor(int descriptor) : fd(descriptor) {}
+  int fd = -1;
+  FileDescriptor(const FileDescriptor&) = delete;
+  FileDescriptor& operator=(const FileDescriptor&) = delete;
+  ~FileDescriptor() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// Whether `bytes` starts with the magic and this glint's format version.
+bool hasMagicAndVersion(std::string_view bytes) {
+  if (bytes.size() < kCheckpointMagic.size() + 4 ||
+      bytes.substr(0, kCheckpointMagic.size()) != kCheckpointMagic)
+    return false;
+  const std::string name;
+  Reader r(bytes.substr(kCheckpointMagic.size()), name);
+  return r.u32() == kCheckpointVersion;
 }
 
 std::string describeRegion(const PixelRegion& r, int width, int height) {
@@ -313,51 +333,114 @@ Checkpoint decodeCheckpoint(std::string_view bytes, const std::string& name,
 
 void writeCheckpoint(const Checkpoint& checkpoint, const fs::path& path) {
   const std::string bytes = encodeCheckpoint(checkpoint);
-  const fs::path folder = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  std::string temporary = (folder / (path.filename().string() + ".tmp-XXXXXX")).string();
-  const auto failure = [&path](const std::string& what) {
-    return CheckpointError(fmt::format("cannot save checkpoint '{}': {}", path.string(), what));
-  };
-  const int fd = mkstemp(temporary.data());
-  if (fd < 0) throw failure(std::strerror(errno));
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const std::string reason = std::strerror(errno);
-      ::close(fd);
-      ::unlink(temporary.c_str());
-      throw failure(reason);
-    }
-    written += static_cast<std::size_t>(n);
-  }
-  // fsync before rename: after a power cut the name points at complete bytes, old or new.
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const std::string reason = std::strerror(errno);
-    ::unlink(temporary.c_str());
-    throw failure(reason);
-  }
-  if (::rename(temporary.c_str(), path.c_str()) != 0) {
-    const std::string reason = std::strerror(errno);
-    ::unlink(temporary.c_str());
-    throw failure(reason);
+  try {
+    AtomicFile file(path, 0600);
+    file.write(bytes);
+    // fsync before rename: after a power cut the name points at complete bytes, old or new.
+    file.close(true);
+    file.commit();
+  } catch (const std::system_error& error) {
+    throw CheckpointError(
+        fmt::format("cannot save checkpoint '{}': {}", path.string(), error.code().message()));
   }
 }
 
+std::optional<std::uint64_t> checkpointSizeLimit(std::string_view header) {
+  if (header.size() < kHeaderBytes || header.substr(0, kCheckpointMagic.size()) != kCheckpointMagic)
+    return std::nullopt;
+  const std::string name;
+  Reader r(header, name);
+  r.bytes(kCheckpointMagic.size());
+  if (r.u32() != kCheckpointVersion) return std::nullopt;
+  r.u32();  // reserved
+  r.u64();  // fingerprint
+  const int width = r.i32();
+  const int height = r.i32();
+  r.bytes(4 + 4 + 8 + 8);  // samples, adaptive maximum and threshold, seed
+  const PixelRegion region{r.i32(), r.i32(), r.i32(), r.i32()};
+  const int tileSize = r.i32();
+  const std::uint64_t tileCount = r.u64();
+  if (width < 1 || height < 1 || region.x0 < 0 || region.x0 >= region.x1 || region.x1 > width ||
+      region.y0 < 0 || region.y0 >= region.y1 || region.y1 > height || tileSize < 1 ||
+      tileCount == 0 || tileCount > static_cast<std::uint64_t>(region.width()) * region.height())
+    return std::nullopt;
+  const std::uint64_t pixels =
+      static_cast<std::uint64_t>(region.width()) * static_cast<std::uint64_t>(region.height());
+  return kHeaderBytes + (tileCount + 7) / 8 + pixels * kPixelBytes + 8;
+}
+
+namespace {
+
+CheckpointError cannotRead(const fs::path& path, const std::string& why) {
+  return CheckpointError(fmt::format("cannot read checkpoint '{}': {}", path.string(), why));
+}
+
+std::string openFailure(int error) {
+  if (error == ENOENT || error == ENOTDIR) return "no such file";
+  if (error == EACCES || error == EPERM) return "permission denied";
+  return std::generic_category().message(error);
+}
+
+CheckpointError notRegular(const fs::path& path, const struct stat& info) {
+  return cannotRead(path, S_ISDIR(info.st_mode)
+                              ? "it is a folder"
+                              : "it is not a regular file (a device, FIFO or socket)");
+}
+
+}  // namespace
+
+void checkCheckpointFile(const fs::path& path) {
+  // stat, not open: reading a device such as /dev/zero would never end, and opening a FIFO would
+  // wait for a writer forever.
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0) throw cannotRead(path, openFailure(errno));
+  if (!S_ISREG(info.st_mode)) throw notRegular(path, info);
+}
+
 Checkpoint readCheckpoint(const fs::path& path, std::uint64_t memoryBudget) {
-  std::error_code error;
-  if (fs::is_directory(path, error))
-    throw CheckpointError(
-        fmt::format("cannot read checkpoint '{}': it is a folder", path.string()));
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw CheckpointError(
-        fmt::format("cannot read checkpoint '{}': {}", path.string(),
-                    fs::exists(path, error) ? "permission denied" : "no such file"));
-  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad())
-    throw CheckpointError(fmt::format("cannot read checkpoint '{}': read error", path.string()));
+  checkCheckpointFile(path);
+  // O_NONBLOCK: should the name have become a FIFO since the stat, the open does not wait; fstat
+  // then sees what was really opened.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) throw cannotRead(path, openFailure(errno));
+  const FileDescriptor closer{fd};
+  struct stat info {};
+  if (::fstat(fd, &info) != 0) throw cannotRead(path, openFailure(errno));
+  if (!S_ISREG(info.st_mode)) throw notRegular(path, info);
+  const auto size = static_cast<std::uint64_t>(info.st_size);
+
+  // Reads up to `count` more bytes into `bytes` (fewer at the end of the file).
+  std::string bytes;
+  const auto readUpTo = [&](std::uint64_t count) {
+    char buffer[1 << 16];
+    while (count > 0) {
+      const ssize_t n = ::read(
+          fd, buffer, static_cast<std::size_t>(std::min<std::uint64_t>(count, sizeof buffer)));
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) throw cannotRead(path, "read error");
+      if (n == 0) return;
+      bytes.append(buffer, static_cast<std::size_t>(n));
+      count -= static_cast<std::uint64_t>(n);
+    }
+  };
+  // The header first: what it promises bounds the rest, so no size read from a damaged or foreign
+  // file makes glint allocate more than the file's own size or a checkpoint of that image needs.
+  readUpTo(std::min<std::uint64_t>(size, kHeaderBytes));
+  const std::optional<std::uint64_t> limit = checkpointSizeLimit(bytes);
+  if (limit && size > *limit)
+    throw CheckpointError(fmt::format(
+        "checkpoint '{}' is corrupt: it holds {} bytes, more than the {} its header allows",
+        path.string(), size, *limit));
+  // Without a sane header the bound is the memory budget: a checkpoint holds at most a film within
+  // it (plus a few bytes). Smaller files are read whole, so that decodeCheckpoint names the damage.
+  if (!limit && size > memoryBudget) {
+    if (!hasMagicAndVersion(bytes))
+      decodeCheckpoint(bytes, path.string(), memoryBudget);  // not a checkpoint; another version
+    throw CheckpointError(fmt::format(
+        "checkpoint '{}' is corrupt: impossible image size, region or tile size", path.string()));
+  }
+  bytes.reserve(static_cast<std::size_t>(size));
+  readUpTo(size - bytes.size());
   return decodeCheckpoint(bytes, path.string(), memoryBudget);
 }
 

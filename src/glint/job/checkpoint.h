@@ -93,9 +93,23 @@ std::string encodeCheckpoint(const Checkpoint& checkpoint);
 Checkpoint decodeCheckpoint(std::string_view bytes, const std::string& name,
                             std::uint64_t memoryBudget = defaultImageMemoryBudget());
 
-// Writes atomically: a temporary file in the same folder, flushed to disk, then renamed over
-// `path`, so a crash or a kill leaves either the old checkpoint or the new one, never a torn one.
+// The largest file (bytes) a checkpoint starting with `header` can be: header, tile bitmap, every
+// pixel of its region, checksum. std::nullopt when `header` is shorter than a header, not of this
+// format and version, or its sizes are impossible.
+std::optional<std::uint64_t> checkpointSizeLimit(std::string_view header);
+
+// Writes atomically: a temporary file in the same folder (core/atomic_file.h), flushed to disk,
+// then renamed over `path`, so a crash or a kill leaves either the old checkpoint or the new one,
+// never a torn one.
 void writeCheckpoint(const Checkpoint& checkpoint, const std::filesystem::path& path);
+// Throws CheckpointError ("cannot read checkpoint 'x': no such file", "...: it is a folder", "...:
+// it is not a regular file (a device, FIFO or socket)") unless `path` names a regular file. Decided
+// by stat alone, so nothing is opened, read or waited on.
+void checkCheckpointFile(const std::filesystem::path& path);
+// Reads and decodes a checkpoint file. Only a regular file is opened (a device or a FIFO is refused
+// before it is read or waited on), and no more is read than the file's size and what its header
+// allows (checkpointSizeLimit), so a foreign file cannot exhaust the memory. Throws
+// CheckpointError.
 Checkpoint readCheckpoint(const std::filesystem::path& path,
                           std::uint64_t memoryBudget = defaultImageMemoryBudget());
 

@@ -1,14 +1,18 @@
 #include "glint/job/checkpoint.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <bit>
+#include <chrono>
+#include <climits>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <limits>
 #include <string>
 
@@ -285,6 +289,91 @@ TEST_F(CheckpointFile, CollectorCopiesExactlyTheFinishedTileAndSavesWhenDue) {
   slow.addTile(0, film);
   EXPECT_FALSE(slow.saveDue());
   EXPECT_THROW(slow.addTile(6, film), std::invalid_argument);
+}
+
+// A device or a FIFO named as a checkpoint is refused by its stat: /dev/zero would be read forever,
+// and opening a FIFO would wait for a writer forever.
+TEST_F(CheckpointFile, DevicesAndFifosAreRefusedWithoutReadingThem) {
+  const fs::path fifo = folder_ / "run.ckpt";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  // /dev/zero is refused the same way (tests/cli_test.cpp, where a read that never ends is killed).
+  for (const fs::path& path : {fifo}) {
+    auto reading = std::async(std::launch::async, [&path]() {
+      try {
+        readCheckpoint(path);
+        return std::string("read");
+      } catch (const CheckpointError& error) {
+        return std::string(error.what());
+      }
+    });
+    if (reading.wait_for(std::chrono::seconds(5)) != std::future_status::ready) {
+      // Unblock the reader (a writer opens and closes the FIFO) so that the test can end.
+      const int writer = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+      if (writer >= 0) ::close(writer);
+      ADD_FAILURE() << "reading " << path << " did not return within 5 s";
+    }
+    EXPECT_EQ(reading.get(), "cannot read checkpoint '" + path.string() +
+                                 "': it is not a regular file (a device, FIFO or socket)");
+  }
+  EXPECT_THROW(checkCheckpointFile(fifo), CheckpointError);
+  EXPECT_THROW(checkCheckpointFile(folder_), CheckpointError);
+  EXPECT_THROW(checkCheckpointFile(folder_ / "missing.ckpt"), CheckpointError);
+}
+
+TEST(Checkpoint, TheHeaderBoundsTheFileSize) {
+  const Checkpoint c = sampleCheckpoint();
+  const std::string bytes = encodeCheckpoint(c);
+  // Header, bitmap (1 byte for 6 tiles), every pixel of the 20 x 13 region, checksum.
+  const std::size_t header = 8 + 4 + 4 + 8 + 4 * 4 + 8 + 8 + 5 * 4 + 8;
+  EXPECT_EQ(checkpointSizeLimit(bytes), header + 1 + 20 * 13 * 24 + 8);
+  EXPECT_GE(*checkpointSizeLimit(bytes), bytes.size());
+  EXPECT_EQ(checkpointSizeLimit(bytes.substr(0, header - 1)), std::nullopt);
+  EXPECT_EQ(checkpointSizeLimit("P6\n1 1\n255\nabc" + std::string(100, 'x')), std::nullopt);
+  std::string impossible = bytes;
+  impossible[24] = 0;  // width 0
+  impossible[25] = 0;
+  EXPECT_EQ(checkpointSizeLimit(impossible), std::nullopt);
+}
+
+// A file larger than its header allows is refused before it is read: a checkpoint's size never
+// decides what glint allocates.
+TEST_F(CheckpointFile, AFileLargerThanItsHeaderAllowsIsRefusedUnread) {
+  const std::string bytes = encodeCheckpoint(sampleCheckpoint());
+  const fs::path path = folder_ / "big.ckpt";
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << bytes;
+  }
+  // Grown to 1 GiB without using the disk (a sparse file).
+  fs::resize_file(path, std::uint64_t{1} << 30);
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    readCheckpoint(path);
+    FAIL() << "expected CheckpointError";
+  } catch (const CheckpointError& error) {
+    EXPECT_NE(std::string(error.what()).find("its header allows"), std::string::npos)
+        << error.what();
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1));
+  // Without a sane header, a file larger than the memory budget is refused unread as well.
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out << "not a checkpoint at all";
+  }
+  fs::resize_file(path, std::uint64_t{1} << 30);
+  try {
+    readCheckpoint(path, std::uint64_t{1} << 20);
+    FAIL() << "expected CheckpointError";
+  } catch (const CheckpointError& error) {
+    EXPECT_EQ(std::string(error.what()), "'" + path.string() + "' is not a glint checkpoint");
+  }
+}
+
+// The temporary file of a save is short and hidden, so a checkpoint name of NAME_MAX bytes works.
+TEST_F(CheckpointFile, TheLongestLegalFileNameIsSaved) {
+  const fs::path path = folder_ / (std::string(NAME_MAX - 5, 'c') + ".ckpt");
+  writeCheckpoint(sampleCheckpoint(), path);
+  EXPECT_EQ(readCheckpoint(path).finishedTiles(), 3u);
 }
 
 }  // namespace

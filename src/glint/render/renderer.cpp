@@ -454,8 +454,12 @@ double standardError(const Color& sum, const Color& sumSquares, std::uint32_t n)
 // stratified Sobol samples the sample variance overestimates the mean's true error: the rule errs
 // toward more samples.) Sample s uses the sampler stream (pixel, s, seed); non-finite samples count
 // as black and are added to `nonFinite`.
-Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
-                  std::uint64_t seed, std::uint64_t& nonFinite) {
+//
+// `cancel` is polled before every sample (one relaxed load beside a whole camera path), so a pixel
+// of millions of rays still stops within one sample; false when it did, leaving `color` unset.
+bool renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
+                 std::uint64_t seed, const std::atomic<bool>* cancel, std::uint64_t& nonFinite,
+                 Color& color) {
   const Camera& camera = ctx.scene.camera();
   // The key and the two camera dimensions are the same for every sample of the pixel. A render
   // that draws no sample never reads the key: its hash is skipped.
@@ -475,6 +479,7 @@ Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column,
   std::uint32_t target = plan.initial;
   for (;;) {
     for (; n < target; ++n) {
+      if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return false;
       const SampleStream stream(pixel.key(), n);
       const Point2 offset = plan.jitter ? offsets.at(n) : Point2{0.5, 0.5};
       const Ray ray =
@@ -491,7 +496,8 @@ Color renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column,
     if (!(standardError(sum, sumSquares, n) > plan.threshold)) break;
     target = std::min(n + plan.batch, plan.maximum);
   }
-  return sum / static_cast<double>(n);
+  color = sum / static_cast<double>(n);
+  return true;
 }
 
 }  // namespace
@@ -502,6 +508,45 @@ Color traceRay(const Scene& scene, const Ray& ray, Rng& rng, RayCounts* counts) 
   std::vector<Hit> hits = hitStorage(scene);
   const TraceContext ctx = makeContext(scene, target, hits);
   return traceCameraRay(ctx, ray, SampleStream(rng.nextBits(), 0));
+}
+
+SamplesPerPixel samplesPerPixel(const ImageSettings& image) {
+  const SamplingPlan plan = samplingPlan(image);
+  return SamplesPerPixel{static_cast<int>(plan.initial), static_cast<int>(plan.maximum)};
+}
+
+PixelWork estimatePixelWork(const ImageSettings& image, const RenderSettings& render,
+                            const std::vector<Light>& lights,
+                            const std::vector<Material>& materials) {
+  PixelWork work;
+  work.samples = static_cast<std::uint64_t>(samplesPerPixel(image).maximum);
+  for (const Light& light : lights) {
+    const auto* area = std::get_if<AreaLight>(&light);
+    work.shadowRaysPerHit += area ? static_cast<std::uint64_t>(std::max(area->samples, 1)) : 1;
+  }
+  bool secondary = false;  // some material reflects or transmits: paths go on to max_depth
+  bool branching = false;  // some material does both: a path forks at every such hit
+  bool glossy = false;
+  double strongest = 0;  // the largest kr or kt component: how slowly a branch's weight falls
+  for (const Material& material : materials) {
+    const bool reflects = !isBlack(material.kr);
+    const bool transmits = !isBlack(material.kt);
+    secondary = secondary || reflects || transmits;
+    branching = branching || (reflects && transmits);
+    glossy = glossy || material.reflectionBlur > 0 || material.refractionBlur > 0;
+    strongest = std::max({strongest, maxComponent(material.kr), maxComponent(material.kt)});
+  }
+  work.glossyRaysPerHit = glossy ? static_cast<std::uint64_t>(std::max(render.blurSamples, 1)) : 0;
+  int depth = secondary ? std::max(render.maxDepth, 1) : 1;
+  // A branch stops once its weight, at most strongest^k after k bounces, is below min_weight.
+  if (secondary && strongest < 1 && render.minWeight > 0) {
+    const double bounces = std::floor(std::log(render.minWeight) / std::log(strongest));
+    if (bounces + 1 < depth) depth = static_cast<int>(std::max(0.0, bounces)) + 1;
+  }
+  work.depth = depth;
+  // A forking path visits up to 2^depth − 1 hits (capped far above any warning threshold).
+  work.hitsPerSample = branching ? std::exp2(std::min(depth, 200)) - 1 : depth;
+  return work;
 }
 
 std::vector<PixelRegion> tileRegions(const PixelRegion& region, int tileSize) {
@@ -581,16 +626,16 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
     bool abandoned = false;
     for (int row = y0; row < y1 && !abandoned; ++row) {
       for (int column = x0; column < x1; ++column) {
-        // Polled per pixel (a relaxed load), so a cancel takes effect within one pixel's samples.
+        // Another thread's stop, polled per pixel; the caller's cancel flag is polled per sample
+        // inside renderPixel.
+        std::uint64_t pixelNonFinite = 0;
         if (cancelled.load(std::memory_order_relaxed) ||
-            (options.cancel && options.cancel->load(std::memory_order_relaxed))) {
+            !renderPixel(ctx, plan, column, row, seed, options.cancel, pixelNonFinite,
+                         film.at(column - region.x0, row - region.y0))) {
           cancelled.store(true);
           abandoned = true;
           break;
         }
-        std::uint64_t pixelNonFinite = 0;
-        film.at(column - region.x0, row - region.y0) =
-            renderPixel(ctx, plan, column, row, seed, pixelNonFinite);
         if (pixelNonFinite > 0 && tileNonFinite == 0) {
           tileFirstNonFinite = PixelCoord{column, row};
         }

@@ -47,8 +47,9 @@ struct RenderOptions {
   int threads = 0;                  // 0 = all cores
   std::optional<PixelRegion> crop;  // default: the whole image
   int tileSize = 16;                // pixels per tile side
-  // Polled before every pixel; when set, render stops within one pixel's samples per thread. A
-  // tile left unfinished is neither reported to tileFinished nor to progress.
+  // Polled before every pixel sample; when set, render stops within one sample per thread (one
+  // camera path with its shadow, glossy and area-light rays). A tile left unfinished is neither
+  // reported to tileFinished nor to progress.
   const std::atomic<bool>* cancel = nullptr;
   // Called (from worker threads, serialised by the renderer) after each finished tile with
   // (tiles done, tiles total).
@@ -63,6 +64,35 @@ struct RenderOptions {
   const Film* resumeFilm = nullptr;
   const std::vector<bool>* resumeTiles = nullptr;
 };
+
+// Samples per pixel a render takes: every pixel takes `minimum`; with adaptive sampling a pixel
+// may take up to `maximum`, otherwise both are image.samples. Adaptive sampling starts with at
+// least 4 samples (fewer give no estimate of a pixel's error), capped at its maximum.
+struct SamplesPerPixel {
+  int minimum = 1;
+  int maximum = 1;
+};
+SamplesPerPixel samplesPerPixel(const ImageSettings& image);
+
+// An upper estimate of the rays one pixel may trace, to warn before a render that cannot finish:
+// samples × hitsPerSample × (1 + shadowRaysPerHit + glossyRaysPerHit). Rough on purpose: glossy
+// and area-light budgets shrink below a glossy split, and weights fall faster than the strongest
+// coefficient suggests.
+struct PixelWork {
+  std::uint64_t samples = 1;           // the most samples a pixel may take
+  int depth = 1;                       // surface hits along one path (max_depth, cut by min_weight)
+  double hitsPerSample = 1;            // depth, or 2^depth − 1 when some material both reflects
+                                       // and transmits (every such hit forks the path)
+  std::uint64_t shadowRaysPerHit = 0;  // one per light, `samples` per area light
+  std::uint64_t glossyRaysPerHit = 0;  // blur_samples when some material is glossy, else 0
+  double raysPerPixel() const {
+    return static_cast<double>(samples) * hitsPerSample *
+           (1 + static_cast<double>(shadowRaysPerHit) + static_cast<double>(glossyRaysPerHit));
+  }
+};
+PixelWork estimatePixelWork(const ImageSettings& image, const RenderSettings& render,
+                            const std::vector<Light>& lights,
+                            const std::vector<Material>& materials);
 
 // The tiles a render of `region` is cut into, in the order render() numbers them: row-major from
 // the region's top-left corner, tileSize × tileSize pixels, clipped at the right and bottom edges.

@@ -570,5 +570,105 @@ TEST(Renderer, CancelStopsInsideATileWithoutReportingIt) {
   EXPECT_LT(seconds, 2.0);
 }
 
+// One pixel of millions of rays (issue 13: 65536 samples, each lit by a 4096-sample area light,
+// about 2.7e8 shadow rays): a cancel must stop it within one sample, not at the pixel's end.
+TEST(Renderer, CancelStopsInsideAPixelWithinOneSample) {
+  SceneParts parts = litPlaneParts(1, 1);
+  parts.image.samples = 65536;
+  AreaLight light;
+  light.shape = AreaShape::Disk;
+  light.center = {0, 0, 5};
+  light.normal = {0, 0, -1};
+  light.radius = 1;
+  light.intensity = Color(1);
+  light.samples = 4096;
+  parts.lights.push_back(light);
+  const Scene scene(std::move(parts));
+  std::atomic<bool> cancel{false};
+  RenderOptions options;
+  options.cancel = &cancel;
+  std::thread canceller([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    cancel = true;
+  });
+  RenderStats stats;
+  const auto start = std::chrono::steady_clock::now();
+  render(scene, options, &stats);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  canceller.join();
+  EXPECT_TRUE(stats.cancelled);
+  EXPECT_LT(stats.rays.camera, 65536u);
+  EXPECT_LT(seconds, 1.0);
+}
+
+TEST(Renderer, SamplesPerPixelIsTheRangeTheRendererTakes) {
+  ImageSettings image;
+  image.samples = 1;
+  EXPECT_EQ(samplesPerPixel(image).minimum, 1);
+  EXPECT_EQ(samplesPerPixel(image).maximum, 1);
+  // Adaptive sampling takes at least 4 samples, whatever image.samples says ...
+  image.adaptive = AdaptiveSampling{64, 0.02};
+  EXPECT_EQ(samplesPerPixel(image).minimum, 4);
+  EXPECT_EQ(samplesPerPixel(image).maximum, 64);
+  // ... but never more than its maximum, and image.samples above the maximum raises it.
+  image.adaptive->maxSamples = 2;
+  EXPECT_EQ(samplesPerPixel(image).minimum, 2);
+  EXPECT_EQ(samplesPerPixel(image).maximum, 2);
+  image.samples = 16;
+  image.adaptive->maxSamples = 8;
+  EXPECT_EQ(samplesPerPixel(image).minimum, 16);
+  EXPECT_EQ(samplesPerPixel(image).maximum, 16);
+
+  // What the renderer really spends: 4 samples per pixel on a flat, noiseless image.
+  SceneParts parts = litPlaneParts(6, 4);
+  parts.image.samples = 1;
+  parts.image.adaptive = AdaptiveSampling{64, 0.02};
+  RenderStats stats;
+  render(Scene(std::move(parts)), {}, &stats);
+  EXPECT_EQ(stats.rays.camera, 6u * 4u * 4u);
+}
+
+TEST(Renderer, PixelWorkCountsSamplesLightsGlossAndDepth) {
+  SceneParts parts = litPlaneParts(1, 1);
+  parts.image.samples = 65536;
+  AreaLight light;
+  light.samples = 65536;
+  parts.lights.push_back(light);
+  PixelWork work = estimatePixelWork(parts.image, parts.render, parts.lights, parts.materials);
+  EXPECT_EQ(work.samples, 65536u);
+  EXPECT_EQ(work.depth, 1) << "nothing reflects or transmits";
+  EXPECT_EQ(work.shadowRaysPerHit, 65536u + 1u);  // the area light and the directional light
+  EXPECT_EQ(work.glossyRaysPerHit, 0u);
+  EXPECT_DOUBLE_EQ(work.raysPerPixel(), 65536.0 * (1 + 65537));
+
+  // A glossy mirror: paths go to max_depth, cut where the weight 0.5^k falls below min_weight.
+  Material mirror;
+  mirror.kr = Color(0.5);
+  mirror.reflectionBlur = 5;
+  parts.materials.push_back(mirror);
+  parts.render.maxDepth = 20;
+  parts.render.minWeight = 0.01;  // 0.5^6 = 0.016 is traced, 0.5^7 = 0.008 is not
+  parts.render.blurSamples = 8;
+  work = estimatePixelWork(parts.image, parts.render, parts.lights, parts.materials);
+  EXPECT_EQ(work.depth, 7);
+  EXPECT_DOUBLE_EQ(work.hitsPerSample, 7);
+  EXPECT_EQ(work.glossyRaysPerHit, 8u);
+  // Glass that reflects and transmits forks every path: 2^depth − 1 hits.
+  Material glass;
+  glass.kr = Color(0.1);
+  glass.kt = Color(0.9);
+  parts.materials.push_back(glass);
+  parts.render.minWeight = 0;
+  work = estimatePixelWork(parts.image, parts.render, parts.lights, parts.materials);
+  EXPECT_EQ(work.depth, 20);
+  EXPECT_DOUBLE_EQ(work.hitsPerSample, std::exp2(20) - 1);
+  // Adaptive sampling: its maximum counts.
+  parts.image.samples = 4;
+  parts.image.adaptive = AdaptiveSampling{128, 0.02};
+  EXPECT_EQ(estimatePixelWork(parts.image, parts.render, parts.lights, parts.materials).samples,
+            128u);
+}
+
 }  // namespace
 }  // namespace glint

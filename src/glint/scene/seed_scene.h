@@ -1,12 +1,11 @@
 // The seed document's test case (four triangles and a sphere, ambient light only, with the grid),
-// built in code. Shared by examples/seed_test_case.cpp and tests/analytic_image_test.cpp.
+// built in code: a scene without a file. Rendered by examples/seed_test_case.cpp and checked
+// pixel by pixel by tests/analytic_image_test.cpp.
 #pragma once
 
-#include <cstdint>
 #include <utility>
 
 #include "glint/geometry/shape.h"
-#include "glint/image/image_writer.h"
 #include "glint/scene/scene.h"
 
 namespace glint::seed {
@@ -17,12 +16,9 @@ namespace glint::seed {
 inline SceneParts testCaseParts(int size = 1000, int gridInterval = 100) {
   SceneParts parts;
   parts.name = "seed test case";
-  // Display colours are "#rrggbb" codes; under linear encoding a code c decodes to c / 255.
-  const auto display = [](int r, int g, int b) {
-    return Color(decodeChannel(static_cast<std::uint8_t>(r), Encoding::Linear),
-                 decodeChannel(static_cast<std::uint8_t>(g), Encoding::Linear),
-                 decodeChannel(static_cast<std::uint8_t>(b), Encoding::Linear));
-  };
+  // Display colours are "#rrggbb" codes; under linear encoding a code c decodes to c / 255
+  // (image/image_writer.h: decodeChannel).
+  const auto display = [](int r, int g, int b) { return Color(r / 255.0, g / 255.0, b / 255.0); };
   parts.background = display(0x4b, 0x7f, 0x5a);
   parts.ambient = display(255, 191, 191) * 1.0;  // colour × intensity 1
 

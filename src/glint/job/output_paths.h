@@ -1,0 +1,32 @@
+// Where a render job writes — the image and the checkpoint — checked before any work, so that a
+// typo costs no render and no input file is ever overwritten by an output.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+
+namespace glint {
+
+// The image a render writes when none is named: the scene file's name with ".png", in the current
+// folder.
+std::filesystem::path defaultOutputPath(const std::filesystem::path& scene);
+
+// Checks the output image path and throws JobError (job/job_error.h) when it cannot be written:
+// BadInput for an unknown extension, a missing folder, or a path that is one of the render's inputs
+// (`scene`, the `resume` checkpoint; compared by file identity and lexically, so "-o scene.png" on
+// a scene file named scene.png is refused); Failure for problems of writing (a folder in its place,
+// an unwritable folder). `scene` may be empty (a scene built in code).
+void checkOutputPath(const std::filesystem::path& output, const std::filesystem::path& scene,
+                     const std::optional<std::filesystem::path>& resume);
+
+// The checkpoint file a render writes: `checkpoint`, or else the `resume` file (a resumed render
+// keeps checkpointing, so it can be interrupted again); std::nullopt when neither is given. Throws
+// JobError when a name is empty, when it is the output image, when its folder is missing or not
+// writable, when it names a folder, when it exists and is not the checkpoint being resumed (work
+// saved in it would be lost), and when `resume` is not a regular file (a device or a FIFO would
+// never finish reading or never open).
+std::optional<std::filesystem::path> resolveCheckpointPath(
+    const std::optional<std::filesystem::path>& checkpoint,
+    const std::optional<std::filesystem::path>& resume, const std::filesystem::path& output);
+
+}  // namespace glint

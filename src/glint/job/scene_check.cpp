@@ -1,0 +1,112 @@
+#include "glint/job/scene_check.h"
+
+#include <fmt/format.h>
+
+#include <new>
+#include <utility>
+#include <variant>
+
+#include "glint/job/job_error.h"
+#include "glint/job/job_steps.h"
+
+namespace glint {
+namespace {
+
+// Whole numbers as digits up to a million, then in words ("4.3 billion").
+std::string countText(double count) {
+  return count < 1e6 ? fmt::format("{:.0f}", count) : formatCount(count);
+}
+
+}  // namespace
+
+LoadedScene loadSceneFile(const std::filesystem::path& file, const LoadOptions& options) {
+  try {
+    return loadScene(file, options);
+  } catch (const SceneError& error) {
+    throw JobError(error);
+  }
+}
+
+void enforceImageLimits(const ImageSettings& image, const std::string& request,
+                        std::uint64_t memoryBudget, int filmCopies) {
+  std::optional<std::string> refusal = checkImageSettings(image, memoryBudget);
+  const std::uint64_t film = filmBytes(image.width, image.height);
+  if (!refusal && filmCopies > 1 && film > memoryBudget / static_cast<std::uint64_t>(filmCopies)) {
+    refusal = fmt::format(
+        "an image of {} × {} pixels needs {} for its film and {} for checkpointing, more than the "
+        "memory budget of {}",
+        image.width, image.height, formatBytes(static_cast<double>(film)),
+        formatBytes(static_cast<double>(film) * static_cast<double>(filmCopies - 1)),
+        formatBytes(static_cast<double>(memoryBudget)));
+  }
+  if (refusal) {
+    throw JobError(JobFailure::BadInput, request.empty()
+                                             ? fmt::format("request refused: {}", *refusal)
+                                             : fmt::format("{} refused: {}", request, *refusal));
+  }
+}
+
+Scene freezeScene(SceneParts parts, const std::string& file) {
+  try {
+    return Scene(std::move(parts));
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& error) {
+    throw JobError(JobFailure::BadInput, fmt::format("{}: {}", file, error.what()));
+  }
+}
+
+SceneFacts sceneFacts(const Scene& scene) {
+  SceneFacts facts;
+  facts.name = scene.name();
+  facts.image = scene.image();
+  facts.samplesPerPixel = samplesPerPixel(scene.image());
+  facts.objects = scene.primitives().size();
+  for (const Primitive& primitive : scene.primitives())
+    facts.unboundedObjects += primitive.isBounded() ? 0 : 1;
+  facts.meshes = scene.meshes().size();
+  facts.triangles = scene.aggregate().triangleCount();
+  facts.lights = scene.lights().size();
+  for (const Light& light : scene.lights())
+    facts.areaLights += std::holds_alternative<AreaLight>(light) ? 1 : 0;
+  facts.ambient = !isBlack(scene.ambient());
+  facts.materials = scene.materials().size() - 1;  // index 0 is the built-in default
+  facts.bounds = scene.aggregate().bounds();
+  facts.maxDepth = scene.render().maxDepth;
+  facts.seed = scene.render().seed;
+  return facts;
+}
+
+std::optional<Diagnostic> pixelWorkWarning(const std::string& file, const SceneParts& parts) {
+  const PixelWork work =
+      estimatePixelWork(parts.image, parts.render, parts.lights, parts.materials);
+  const double rays = work.raysPerPixel();
+  if (!(rays > kAbsurdRaysPerPixel)) return std::nullopt;
+  const double perHit =
+      1 + static_cast<double>(work.shadowRaysPerHit) + static_cast<double>(work.glossyRaysPerHit);
+  return Diagnostic{
+      Diagnostic::Severity::Warning,
+      {file, 0, 0},
+      fmt::format("one pixel may trace about {} rays ({} {} × {} surface {} per sample × {} rays "
+                  "per hit: {} shadow, {} glossy and the ray to the hit), more than {}; the render "
+                  "may never finish. Lower image.samples, image.adaptive.max_samples, the area "
+                  "lights' samples, render.blur_samples or render.max_depth",
+                  countText(rays), work.samples, work.samples == 1 ? "sample" : "samples",
+                  countText(work.hitsPerSample), work.hitsPerSample == 1 ? "hit" : "hits",
+                  countText(perHit), work.shadowRaysPerHit, work.glossyRaysPerHit,
+                  countText(kAbsurdRaysPerPixel))};
+}
+
+SceneFacts checkScene(const std::filesystem::path& file, const CheckOptions& options) {
+  LoadOptions load;
+  load.memoryBudget = options.memoryBudget;
+  load.cancel = options.cancel;
+  LoadedScene loaded = loadSceneFile(file, load);
+  if (std::optional<Diagnostic> warning = pixelWorkWarning(file.string(), loaded.parts))
+    loaded.warnings.push_back(std::move(*warning));
+  if (options.warnings && !loaded.warnings.empty()) options.warnings(loaded.warnings);
+  enforceImageLimits(loaded.parts.image, "", options.memoryBudget);
+  return sceneFacts(freezeScene(std::move(loaded.parts), file.string()));
+}
+
+}  // namespace glint
