@@ -1,10 +1,9 @@
 #include "glint/mesh/assimp_import.h"
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <exception>
 #include <new>
 #include <set>
@@ -22,6 +21,7 @@
 #include <fmt/format.h>
 #include <assimp/Importer.hpp>
 
+#include "glint/mesh/file_access.h"
 #include "glint/mesh/mesh_repair.h"
 #include "glint/scene/scene_limits.h"
 
@@ -31,27 +31,68 @@ namespace {
 
 constexpr std::uint32_t kUnused = 0xffffffffu;
 
+// assimp's stream over a file glint opened itself (DefaultIOStream's constructor from a FILE* is
+// protected); closed when assimp deletes it.
+class OpenedFileStream : public Assimp::DefaultIOStream {
+ public:
+  OpenedFileStream(FILE* file, const std::string& name) : DefaultIOStream(file, name) {}
+};
+
 // assimp's file access for one mesh file and the files it names (MTL, glTF buffers): only regular
-// files, read-only. A name such as /dev/zero or a FIFO in a hostile file would otherwise be read
-// without end or block forever.
+// files (file_access.h: never opened when they are not, and checked again on what was opened),
+// read-only. A name such as /dev/zero or a FIFO in a hostile file would otherwise be read without
+// end or block forever; a named file that exists but is not regular refuses the whole mesh file
+// (refusal()), which DESIGN.md §9 asks of every file a mesh names.
 class RegularFilesOnly : public Assimp::DefaultIOSystem {
  public:
+  explicit RegularFilesOnly(const std::filesystem::path& meshFile)
+      : meshFile_(meshFile.string()), meshFolder_(meshFile.parent_path().string()) {}
+
   using DefaultIOSystem::Exists;
   Assimp::IOStream* Open(const char* file, const char* mode) override {
     if (file == nullptr || mode == nullptr ||
         std::string_view(mode).find_first_of("wa+") != std::string_view::npos) {
       return nullptr;
     }
-    return isRegular(file) ? DefaultIOSystem::Open(file, mode) : nullptr;
+    RegularFile opened = openRegularFile(file);
+    if (!accepted(file, opened)) return nullptr;
+    FILE* stream = ::fdopen(opened.handle.get(), "rb");
+    if (stream == nullptr) return nullptr;
+    opened.handle.release();  // the stream closes it
+    return new OpenedFileStream(stream, file);
   }
   // DefaultIOSystem::Exists opens the file with fopen, which blocks on a FIFO.
-  bool Exists(const char* file) const override { return isRegular(file); }
+  bool Exists(const char* file) const override {
+    return file != nullptr && accepted(file, statRegularFile(file));
+  }
+
+  // Why a file the mesh file names refuses it ("" when none did), in the user's words.
+  const std::string& refusal() const { return refusal_; }
 
  private:
-  static bool isRegular(const char* file) {
-    struct stat info {};
-    return file != nullptr && ::stat(file, &info) == 0 && S_ISREG(info.st_mode);
+  bool accepted(const char* file, const RegularFile& found) const {
+    if (found.refusal == FileRefusal::NotRegular && refusal_.empty()) {
+      refusal_ = file == meshFile_ ? std::string("it is not a regular file")
+                                   : fmt::format(
+                                         "it refers to '{}', which is not a regular file (a file "
+                                         "a mesh names is never read from a FIFO or a device)",
+                                         asWritten(file));
+    }
+    return found.refusal == FileRefusal::None;
   }
+  // A path assimp formed for a reference, as the mesh file wrote it: without the mesh file's
+  // folder that assimp put in front.
+  std::string asWritten(std::string_view file) const {
+    if (!meshFolder_.empty() && file.size() > meshFolder_.size() &&
+        file.substr(0, meshFolder_.size()) == meshFolder_ && file[meshFolder_.size()] == '/') {
+      file.remove_prefix(meshFolder_.size() + 1);
+    }
+    return std::string(file);
+  }
+
+  std::string meshFile_;
+  std::string meshFolder_;
+  mutable std::string refusal_;  // set by the first refused file, from the const Exists too
 };
 
 // Leaves `importer` with only the importer(s) for `extension`: the glTF 2.0 one for .gltf/.glb
@@ -141,7 +182,8 @@ MeshMaterial convertMaterial(const aiMaterial& m) {
 
 MeshFile importMesh(const std::filesystem::path& path, const std::string& extension) {
   Assimp::Importer importer;
-  importer.SetIOHandler(new RegularFilesOnly);  // the importer owns it
+  auto* files = new RegularFilesOnly(path);
+  importer.SetIOHandler(files);  // the importer owns it
   keepOnlyImporterFor(importer, extension);
   // Points and lines are not surfaces: SortByPType removes them after triangulation.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
@@ -163,6 +205,7 @@ MeshFile importMesh(const std::filesystem::path& path, const std::string& extens
   try {
     // Read without post-processing first: the faces are checked before any step indexes with them.
     const aiScene* scene = importer.ReadFile(path.string(), 0);
+    if (!files->refusal().empty()) throw MeshLoadError(files->refusal());
     if (scene == nullptr) throw MeshLoadError(assimpReason(importer.GetErrorString()));
     // The importer owns the scene and its steps edit it in place; so does dropInvalidFaces.
     result.droppedTriangles = dropInvalidFaces(const_cast<aiScene&>(*scene));

@@ -1,7 +1,5 @@
 #include "glint/mesh/format_checks.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,42 +10,29 @@
 #include <exception>
 #include <sstream>
 #include <string_view>
-#include <system_error>
 
 #include <fmt/format.h>
 
+#include "glint/mesh/file_access.h"
 #include "glint/mesh/mesh_file.h"
 #include "glint/scene/scene_limits.h"
 
 namespace glint {
 
-std::string systemReason(int error) {
-  std::string text = std::generic_category().message(error);
-  if (!text.empty()) text[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(text[0])));
-  return text;
-}
-
 std::string readHeader(const std::filesystem::path& path, std::uint64_t& size) {
-  struct stat info {};
-  if (::stat(path.c_str(), &info) != 0) {
-    const int error = errno;
-    throw MeshLoadError(error == ENOENT ? std::string("no such file") : systemReason(error));
-  }
-  if (S_ISDIR(info.st_mode)) throw MeshLoadError("it is a folder, not a mesh file");
-  if (!S_ISREG(info.st_mode)) throw MeshLoadError("it is not a regular file");
+  const RegularFile checked = statRegularFile(path);
+  if (checked.refusal != FileRefusal::None) throw MeshLoadError(meshFileRefusal(checked));
   checkedExtension(path);  // before the file is opened
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw MeshLoadError(systemReason(errno));
-  size = static_cast<std::uint64_t>(info.st_size);
+  const RegularFile file = openMeshFile(path);
+  size = file.size;
   std::string header(kHeaderBytes, '\0');
   std::size_t filled = 0;
   while (filled < header.size()) {
-    const ssize_t n = ::read(fd, header.data() + filled, header.size() - filled);
+    const ssize_t n = ::read(file.handle.get(), header.data() + filled, header.size() - filled);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;
     filled += static_cast<std::size_t>(n);
   }
-  ::close(fd);
   header.resize(filled);
   return header;
 }
@@ -215,15 +200,14 @@ void checkGltfPrimitives(const std::filesystem::path& path, const std::string& e
                          std::uint64_t size) {
   std::string text;
   {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) throw MeshLoadError(systemReason(errno));
+    const RegularFile file = openMeshFile(path);
+    const int fd = file.handle.get();
     std::uint64_t want = size;
     if (extension == ".glb") {
       // 12-byte header ("glTF", version, length), then the JSON chunk: length, "JSON", data.
       unsigned char head[20] = {};
       if (::read(fd, head, sizeof head) != static_cast<ssize_t>(sizeof head) ||
           std::memcmp(head + 16, "JSON", 4) != 0) {
-        ::close(fd);
         return;  // not a GLB assimp would read past its header: its own error
       }
       want = std::uint64_t{head[12]} | std::uint64_t{head[13]} << 8 |
@@ -238,7 +222,6 @@ void checkGltfPrimitives(const std::filesystem::path& path, const std::string& e
       if (n <= 0) break;
       filled += static_cast<std::size_t>(n);
     }
-    ::close(fd);
     text.resize(filled);
   }
   const yaml::Stream json = parseGltfJson(text);

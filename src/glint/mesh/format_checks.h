@@ -21,9 +21,6 @@ inline constexpr const char* kMeshExtensions[] = {".obj", ".ply", ".stl", ".gltf
 // Bytes of a mesh file's start that readHeader returns, and within which a PLY header must end.
 inline constexpr std::size_t kHeaderBytes = 64 * 1024;
 
-// The system's words for an errno, starting lower-case to follow "cannot load mesh file 'x': ".
-std::string systemReason(int error);
-
 // The path's extension in lower case ("" when it has none).
 std::string lowerExtension(const std::filesystem::path& path);
 

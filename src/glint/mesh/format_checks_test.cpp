@@ -8,9 +8,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <string>
 
+#include "glint/mesh/mesh_cache.h"
 #include "glint/mesh/mesh_file.h"
+#include "glint/mesh/mesh_size_estimate.h"
 #include "glint/mesh/mesh_test_support.h"
 
 namespace glint::mesh_test {
@@ -95,19 +98,37 @@ TEST(MeshFormatChecks, OnlyTheDocumentedFormatsReachAnImporter) {
   }
 }
 
+TEST(MeshFormatChecks, AMeshFileThatIsAFifoIsRefusedWithoutOpeningIt) {
+  // Opening a FIFO for reading blocks until a writer comes; reading it never ends while one
+  // stays. The mesh file is stat'ed before it is opened, for the read and for the estimate.
+  TempDir dir;
+  for (const char* name : {"pipe.obj", "pipe.ply", "pipe.stl", "pipe.gltf", "pipe.glb"}) {
+    const fs::path fifo = dir.path() / name;
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    withFifoWatchdog(fifo, [&] {
+      EXPECT_EQ(reasonFor(fifo), "it is not a regular file") << name;
+      EXPECT_THROW(estimateMeshSize(fifo), MeshLoadError) << name;
+      MeshCache cache;
+      EXPECT_THROW(cache.load(fifo, MeshBudget{std::uint64_t{1} << 30, 0}), MeshLoadError) << name;
+    });
+  }
+}
+
 TEST(MeshFormatChecks, FilesAMeshNamesAreReadOnlyWhenRegular) {
   TempDir dir;
-  // An MTL that is a FIFO would block the load forever; /dev/zero would never end. Both are
-  // skipped: the OBJ loads with the default material.
+  // An MTL that is a FIFO would block the load forever: it is not opened, and the mesh file that
+  // names it is refused, naming it.
   const fs::path fifo = dir.path() / "pipe.mtl";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  for (const char* library : {"pipe.mtl", "/dev/zero"}) {
-    const fs::path obj =
-        dir.write("m.obj", std::string("mtllib ") + library +
-                               "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
-    const MeshFile file = readMeshFile(obj);
-    EXPECT_EQ(file.triangleCount(), 1u) << library;
-  }
+  const std::string triangle = "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+  withFifoWatchdog(fifo, [&] {
+    EXPECT_EQ(reasonFor(dir.write("m.obj", "mtllib pipe.mtl" + triangle)),
+              "it refers to 'pipe.mtl', which is not a regular file (a file a mesh names is never "
+              "read from a FIFO or a device)");
+  });
+  // /dev/zero would never end; assimp looks for it inside the mesh file's folder, where there is
+  // none: the OBJ loads with the default material.
+  EXPECT_EQ(readMeshFile(dir.write("z.obj", "mtllib /dev/zero" + triangle)).triangleCount(), 1u);
   // A glTF buffer on /dev/zero with a huge stated length is refused, not read.
   const std::string gltf =
       R"({"asset":{"version":"2.0"},"buffers":[{"uri":"/dev/zero","byteLength":100000000000}],)"

@@ -25,7 +25,7 @@
 #include <fmt/format.h>
 
 #include "glint/mesh/assimp_import.h"
-#include "glint/mesh/format_checks.h"
+#include "glint/mesh/file_access.h"
 
 namespace glint {
 

@@ -1,12 +1,11 @@
 #include "glint/mesh/mesh_cache.h"
 
-#include <sys/stat.h>
-
 #include <string>
 #include <system_error>
 
 #include <fmt/format.h>
 
+#include "glint/mesh/file_access.h"
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/mesh_size_estimate.h"
 #include "glint/scene/scene_limits.h"
@@ -51,13 +50,12 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
   // An OBJ or STL whose size alone shows that no estimate could exceed the budget is not scanned
   // (a 100k-triangle OBJ: ~10 ms saved). A file that cannot be read fails in read() instead.
   bool bounded = false;
-  if (!cached) {
-    const std::string ext = lowerExtension(path);
-    struct stat info {};
-    if ((ext == ".obj" || ext == ".stl") && ::stat(path.c_str(), &info) == 0 &&
-        S_ISREG(info.st_mode)) {
+  const std::string ext = lowerExtension(path);
+  if (!cached && (ext == ".obj" || ext == ".stl")) {
+    const RegularFile file = statRegularFile(path);
+    if (file.refusal == FileRefusal::None) {
       const double bound =
-          kMeshBudgetBytesPerFileByte * static_cast<double>(info.st_size) + kMeshBudgetSlackBytes;
+          kMeshBudgetBytesPerFileByte * static_cast<double>(file.size) + kMeshBudgetSlackBytes;
       bounded = meshBytes_ + bound + static_cast<double>(budget.otherBytes) <=
                 static_cast<double>(budget.limit);
     }

@@ -1,7 +1,5 @@
 #include "glint/mesh/mesh_size_estimate.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "glint/mesh/file_access.h"
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/mesh_file.h"
 
@@ -27,8 +26,8 @@ constexpr std::size_t kMaxScannedLine = 256;
 
 template <typename LineFn>
 void forEachLine(const std::filesystem::path& path, LineFn&& line) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw MeshLoadError(systemReason(errno));
+  const RegularFile file = openMeshFile(path);
+  const int fd = file.handle.get();
   std::string carried;  // the start of a line that continues in the next read
   bool carrying = false;
   const auto keep = [&](const char* begin, std::size_t size) {
@@ -38,11 +37,7 @@ void forEachLine(const std::filesystem::path& path, LineFn&& line) {
   for (;;) {
     const ssize_t n = ::read(fd, buffer.data(), buffer.size());
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      const int error = errno;
-      ::close(fd);
-      throw MeshLoadError(systemReason(error));
-    }
+    if (n < 0) throw MeshLoadError(systemReason(errno));
     if (n == 0) break;
     const char* at = buffer.data();
     const char* const end = at + n;
@@ -66,7 +61,6 @@ void forEachLine(const std::filesystem::path& path, LineFn&& line) {
       at = newline + 1;
     }
   }
-  ::close(fd);
   if (carrying && !carried.empty()) line(std::string_view(carried));
 }
 
@@ -102,16 +96,14 @@ std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size) {
   if (size > (std::uint64_t{64} << 20)) return total;  // a .gltf this big holds its own data
   std::string text;
   {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) throw MeshLoadError(systemReason(errno));
+    const RegularFile file = openMeshFile(path);
     char buffer[1 << 16];
     for (;;) {
-      const ssize_t n = ::read(fd, buffer, sizeof buffer);
+      const ssize_t n = ::read(file.handle.get(), buffer, sizeof buffer);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0 || text.size() > size) break;
       text.append(buffer, static_cast<std::size_t>(n));
     }
-    ::close(fd);
   }
   std::set<std::string> seen;
   for (std::size_t at = text.find("\"uri\""); at != std::string::npos;
@@ -122,11 +114,8 @@ std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size) {
     if (close == std::string::npos) break;
     const std::string uri = text.substr(open + 1, close - open - 1);
     if (uri.rfind("data:", 0) == 0 || !seen.insert(uri).second) continue;
-    struct stat info {};
-    const std::filesystem::path file = path.parent_path() / uri;
-    if (::stat(file.c_str(), &info) == 0 && S_ISREG(info.st_mode)) {
-      total += static_cast<std::uint64_t>(info.st_size);
-    }
+    const RegularFile file = statRegularFile(path.parent_path() / uri);
+    if (file.refusal == FileRefusal::None) total += file.size;
   }
   return total;
 }

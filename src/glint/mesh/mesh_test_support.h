@@ -1,17 +1,22 @@
 // What the mesh loader's tests share: Debian's assimp-testmodels (real files no one here wrote),
-// a temporary folder per test, the bounds and well-formedness of a loaded MeshFile, and the
-// reason a file is refused.
+// a temporary folder per test, the bounds and well-formedness of a loaded MeshFile, the reason a
+// file is refused, and a watchdog that keeps a test with a FIFO bounded in time.
 #pragma once
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <system_error>
+#include <thread>
 #include <vector>
 
 #include "glint/core/bounds.h"
@@ -104,6 +109,33 @@ inline std::string reasonFor(const fs::path& path) {
     return e.what();
   }
   return "(loaded)";
+}
+
+// Runs `body`; if it has not returned within `limit`, fails the test and opens the FIFO `fifo` for
+// writing (and closes it) until it returns: a reader blocked in open() on it goes on and reads the
+// end of the file, so a test of "a FIFO is never opened" ends even when the code under test does
+// open it (also from the mesh reader's child process).
+inline void withFifoWatchdog(const fs::path& fifo, const std::function<void()>& body,
+                             std::chrono::milliseconds limit = std::chrono::seconds(5)) {
+  std::atomic<bool> done{false};
+  std::thread watchdog([&] {
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    bool failed = false;
+    while (!done.load()) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        if (!failed)
+          ADD_FAILURE() << "blocked on the FIFO " << fifo << " for " << limit.count()
+                        << " ms: it was opened";
+        failed = true;
+        const int writer = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+        if (writer >= 0) ::close(writer);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  });
+  body();
+  done = true;
+  watchdog.join();
 }
 
 }  // namespace glint::mesh_test
