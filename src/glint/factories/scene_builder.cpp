@@ -664,8 +664,10 @@ class Builder {
     std::shared_ptr<const MeshFile> file;
     try {
       // Estimated (mesh + BVH, with the film) against the memory limit before anything is read.
-      file = meshCache_.load(path, MeshBudget{options_.imageMemoryBudget,
-                                              filmBytes(parts_.image.width, parts_.image.height)});
+      file = meshCache_.load(path,
+                             MeshBudget{options_.imageMemoryBudget,
+                                        filmBytes(parts_.image.width, parts_.image.height)},
+                             MeshReadOptions{.sceneFolder = d_.baseDirectory});
     } catch (const MeshLoadError& e) {
       std::string reason = e.what();
       if (path != written && reason == "no such file") {

@@ -38,15 +38,16 @@ class OpenedFileStream : public Assimp::DefaultIOStream {
   OpenedFileStream(FILE* file, const std::string& name) : DefaultIOStream(file, name) {}
 };
 
-// assimp's file access for one mesh file and the files it names (MTL, glTF buffers): only regular
-// files (file_access.h: never opened when they are not, and checked again on what was opened),
-// read-only. A name such as /dev/zero or a FIFO in a hostile file would otherwise be read without
-// end or block forever; a named file that exists but is not regular refuses the whole mesh file
-// (refusal()), which DESIGN.md §9 asks of every file a mesh names.
-class RegularFilesOnly : public Assimp::DefaultIOSystem {
+// assimp's file access for one mesh file and the files it names (MTL, glTF buffers): regular files
+// only (file_access.h: never opened when they are not, and checked again on what was opened),
+// read-only, and the named files only inside the folder tree of `rule`. A name such as /dev/zero
+// or a FIFO in a hostile file would otherwise be read without end or block forever, and one such
+// as ../../etc/passwd would be read from anywhere. A named file that breaks a rule refuses the
+// whole mesh file (refusal()), as DESIGN.md §9 asks of every file a mesh names; one that does not
+// exist is left to the importer (an OBJ without its MTL still loads).
+class MeshFileAccess : public Assimp::DefaultIOSystem {
  public:
-  explicit RegularFilesOnly(const std::filesystem::path& meshFile)
-      : meshFile_(meshFile.string()), meshFolder_(meshFile.parent_path().string()) {}
+  explicit MeshFileAccess(const ReferencedFileRule& rule) : rule_(rule) {}
 
   using DefaultIOSystem::Exists;
   Assimp::IOStream* Open(const char* file, const char* mode) override {
@@ -54,8 +55,11 @@ class RegularFilesOnly : public Assimp::DefaultIOSystem {
         std::string_view(mode).find_first_of("wa+") != std::string_view::npos) {
       return nullptr;
     }
+    if (refused(rule_.refusal(file))) return nullptr;
     RegularFile opened = openRegularFile(file);
-    if (!accepted(file, opened)) return nullptr;
+    if (!accepted(file, opened) || refused(rule_.openedRefusal(opened.handle.get(), file))) {
+      return nullptr;
+    }
     FILE* stream = ::fdopen(opened.handle.get(), "rb");
     if (stream == nullptr) return nullptr;
     opened.handle.release();  // the stream closes it
@@ -63,36 +67,32 @@ class RegularFilesOnly : public Assimp::DefaultIOSystem {
   }
   // DefaultIOSystem::Exists opens the file with fopen, which blocks on a FIFO.
   bool Exists(const char* file) const override {
-    return file != nullptr && accepted(file, statRegularFile(file));
+    return file != nullptr && !refused(rule_.refusal(file)) &&
+           accepted(file, statRegularFile(file));
   }
 
   // Why a file the mesh file names refuses it ("" when none did), in the user's words.
   const std::string& refusal() const { return refusal_; }
 
  private:
+  // Keeps the first refusal; true when `why` is one.
+  bool refused(const std::string& why) const {
+    if (!why.empty() && refusal_.empty()) refusal_ = why;
+    return !why.empty();
+  }
   bool accepted(const char* file, const RegularFile& found) const {
-    if (found.refusal == FileRefusal::NotRegular && refusal_.empty()) {
-      refusal_ = file == meshFile_ ? std::string("it is not a regular file")
-                                   : fmt::format(
-                                         "it refers to '{}', which is not a regular file (a file "
-                                         "a mesh names is never read from a FIFO or a device)",
-                                         asWritten(file));
+    if (found.refusal == FileRefusal::NotRegular) {
+      refused(rule_.isMeshFile(file)
+                  ? std::string("it is not a regular file")
+                  : fmt::format("it refers to '{}', which is not a regular file (a file a mesh "
+                                "names is never read from a FIFO or a device)",
+                                rule_.asWritten(file)));
     }
     return found.refusal == FileRefusal::None;
   }
-  // A path assimp formed for a reference, as the mesh file wrote it: without the mesh file's
-  // folder that assimp put in front.
-  std::string asWritten(std::string_view file) const {
-    if (!meshFolder_.empty() && file.size() > meshFolder_.size() &&
-        file.substr(0, meshFolder_.size()) == meshFolder_ && file[meshFolder_.size()] == '/') {
-      file.remove_prefix(meshFolder_.size() + 1);
-    }
-    return std::string(file);
-  }
 
-  std::string meshFile_;
-  std::string meshFolder_;
-  mutable std::string refusal_;  // set by the first refused file, from the const Exists too
+  const ReferencedFileRule& rule_;  // outlives the importer (importMesh's caller holds it)
+  mutable std::string refusal_;     // set by the first refused file, from the const Exists too
 };
 
 // Leaves `importer` with only the importer(s) for `extension`: the glTF 2.0 one for .gltf/.glb
@@ -180,9 +180,10 @@ MeshMaterial convertMaterial(const aiMaterial& m) {
 
 }  // namespace
 
-MeshFile importMesh(const std::filesystem::path& path, const std::string& extension) {
+MeshFile importMesh(const std::filesystem::path& path, const std::string& extension,
+                    const ReferencedFileRule& rule) {
   Assimp::Importer importer;
-  auto* files = new RegularFilesOnly(path);
+  auto* files = new MeshFileAccess(rule);
   importer.SetIOHandler(files);  // the importer owns it
   keepOnlyImporterFor(importer, extension);
   // Points and lines are not surfaces: SortByPType removes them after triangulation.

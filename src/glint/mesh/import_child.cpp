@@ -205,7 +205,8 @@ std::chrono::steady_clock::duration meshReadTimeLimit(const std::filesystem::pat
 
 }  // namespace
 
-MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension) {
+MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension,
+                           const ReferencedFileRule& rule) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw MeshLoadError(systemReason(errno));
   // The answer travels in a memory file when it can: the child writes it whole without waiting for
@@ -240,7 +241,7 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
     MeshFile result;
     std::string error;
     try {
-      result = importMesh(path, extension);
+      result = importMesh(path, extension, rule);
     } catch (const MeshLoadError& e) {
       error = e.what();
     } catch (...) {

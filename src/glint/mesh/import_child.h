@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "glint/mesh/file_access.h"
 #include "glint/mesh/mesh_file.h"
 
 namespace glint {
@@ -20,6 +21,7 @@ inline constexpr double kMeshReadSecondsPerMiB = 2;
 // importMesh (assimp_import.h) run in a child process; the parent checks the answer (sizes,
 // indices, materials) before returning it. A crash of the child, an answer cut short or
 // inconsistent, or the time limit is a MeshLoadError.
-MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension);
+MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension,
+                           const ReferencedFileRule& rule);
 
 }  // namespace glint

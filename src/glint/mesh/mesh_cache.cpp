@@ -21,14 +21,15 @@ std::filesystem::path MeshCache::keyOf(const std::filesystem::path& path) {
 }
 
 std::shared_ptr<const MeshFile> MeshCache::read(const std::filesystem::path& key,
-                                                const std::filesystem::path& path) {
+                                                const std::filesystem::path& path,
+                                                const MeshReadOptions& options) {
   if (const auto it = entries_.find(key); it != entries_.end()) {
     if (it->second.file) return it->second.file;
     throw MeshLoadError(it->second.error);
   }
   ++filesRead_;
   try {
-    auto file = std::make_shared<const MeshFile>(readMeshFile(path));
+    auto file = std::make_shared<const MeshFile>(readMeshFile(path, options));
     entries_[key] = {file, {}};
     return file;
   } catch (const MeshLoadError& e) {
@@ -37,12 +38,14 @@ std::shared_ptr<const MeshFile> MeshCache::read(const std::filesystem::path& key
   }
 }
 
-std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path) {
-  return read(keyOf(path), path);
+std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path,
+                                                const MeshReadOptions& options) {
+  return read(keyOf(path), path, options);
 }
 
 std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path,
-                                                const MeshBudget& budget) {
+                                                const MeshBudget& budget,
+                                                const MeshReadOptions& options) {
   const std::filesystem::path key = keyOf(path);
   const auto it = entries_.find(key);
   if (it != entries_.end() && !it->second.file) throw MeshLoadError(it->second.error);
@@ -63,7 +66,7 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
   if (!cached && !bounded) {
     MeshSizeEstimate size;
     try {
-      size = estimateMeshSize(path);
+      size = estimateMeshSize(path, options);
     } catch (const MeshLoadError& e) {
       entries_[key] = {nullptr, e.what()};
       ++filesRead_;
@@ -84,7 +87,7 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
           formatBytes(static_cast<double>(budget.limit))));
     }
   }
-  std::shared_ptr<const MeshFile> file = read(key, path);
+  std::shared_ptr<const MeshFile> file = read(key, path, options);
   // The real sizes replace the estimate.
   double triangles = 0;
   double vertices = 0;

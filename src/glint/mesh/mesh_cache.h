@@ -50,10 +50,13 @@ class MeshTooLargeError : public MeshLoadError {
 class MeshCache {
  public:
   // The file's content, shared by every caller asking for the same file. Throws MeshLoadError.
-  std::shared_ptr<const MeshFile> load(const std::filesystem::path& path);
+  // The options of the first read of a file hold for the cache's life: one cache, one scene.
+  std::shared_ptr<const MeshFile> load(const std::filesystem::path& path,
+                                       const MeshReadOptions& options = {});
   // The same, counted against `budget` as one more mesh object. Throws MeshTooLargeError (not
   // remembered: the file itself is fine) or MeshLoadError.
-  std::shared_ptr<const MeshFile> load(const std::filesystem::path& path, const MeshBudget& budget);
+  std::shared_ptr<const MeshFile> load(const std::filesystem::path& path, const MeshBudget& budget,
+                                       const MeshReadOptions& options = {});
   // Files actually read (not served from the cache).
   std::size_t filesRead() const { return filesRead_; }
   // Estimated bytes of every mesh loaded with a budget so far: cached files, world copies, BVH.
@@ -66,7 +69,8 @@ class MeshCache {
   };
   static std::filesystem::path keyOf(const std::filesystem::path& path);
   std::shared_ptr<const MeshFile> read(const std::filesystem::path& key,
-                                       const std::filesystem::path& path);
+                                       const std::filesystem::path& path,
+                                       const MeshReadOptions& options);
   std::map<std::filesystem::path, Entry> entries_;
   std::size_t filesRead_ = 0;
   double meshBytes_ = 0;

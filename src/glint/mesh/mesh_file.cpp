@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "glint/mesh/file_access.h"
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/import_child.h"
 
@@ -19,13 +20,13 @@ double meshCopyBytes(double triangles, double vertices) {
   return kMeshBytesPerTriangle * triangles + kMeshBytesPerVertex * vertices;
 }
 
-MeshFile readMeshFile(const std::filesystem::path& path) {
+MeshFile readMeshFile(const std::filesystem::path& path, const MeshReadOptions& options) {
   std::uint64_t size = 0;
   const std::string header = readHeader(path, size);
   const std::string extension = checkedExtension(path);
   if (extension == ".ply") checkPlyHeader(header, size);
   if (extension == ".gltf" || extension == ".glb") checkGltfPrimitives(path, extension, size);
-  return importMeshInChild(path, extension);
+  return importMeshInChild(path, extension, ReferencedFileRule(path, options.sceneFolder));
 }
 
 std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,

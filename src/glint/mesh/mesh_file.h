@@ -86,17 +86,26 @@ struct MeshFile {
   std::size_t triangleCount() const;
 };
 
+// How a mesh file is read, besides its path.
+struct MeshReadOptions {
+  // The scene file's folder. The files a mesh file names (MTL libraries, glTF buffers and images)
+  // must lie in this folder or below, or, for a mesh file outside it, in the mesh file's own
+  // folder or below; empty: always the mesh file's own folder (ReferencedFileRule, file_access.h).
+  std::filesystem::path sceneFolder;
+};
+
 // Reads and converts a mesh file. Throws MeshLoadError: no such file, a folder or other non-regular
 // file, unreadable, an extension not in kMeshExtensions, a PLY header declaring more elements
 // than the file can hold or more faces than kMaxMeshTriangles (checked before assimp
 // reserves memory for them), a file assimp rejects (its reason), no triangles, more than
 // kMaxMeshTriangles, or more than half the machine's memory. Files the mesh file refers to (MTL,
-// glTF buffers) are opened only when they are regular files: never a device or a pipe. A PLY
-// header must end (end_header) within 64 KiB; a glTF strip or fan primitive needs its vertices.
+// glTF buffers) are opened only when they are regular files (never a device or a pipe) inside the
+// folder tree of MeshReadOptions::sceneFolder; one that is not refuses the mesh file, naming it. A
+// PLY header must end (end_header) within 64 KiB; a glTF strip or fan primitive needs its vertices.
 // assimp runs in a child process (fork) that sends the result back through a pipe: fuzzing found
 // memory corruption inside assimp 5.2's importers, which there becomes a refused file ("the mesh
 // library crashed reading it") instead of a crashed or corrupted renderer.
-MeshFile readMeshFile(const std::filesystem::path& path);
+MeshFile readMeshFile(const std::filesystem::path& path, const MeshReadOptions& options = {});
 
 // The world-space meshes of one mesh object: every part of `file` with `worldFromFile` applied —
 // positions by the transform, normals by its inverse transpose, renormalised; a transform that

@@ -91,7 +91,8 @@ std::string_view firstWord(std::string_view line) {
 
 // Bytes of the glTF file plus the regular files its "uri" strings name (data: URIs are inside the
 // file already). A plain scan for `"uri"`, not a JSON parse: an estimate needs no more.
-std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size) {
+std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size,
+                        const ReferencedFileRule& rule) {
   std::uint64_t total = size;
   if (size > (std::uint64_t{64} << 20)) return total;  // a .gltf this big holds its own data
   std::string text;
@@ -114,7 +115,10 @@ std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size) {
     if (close == std::string::npos) break;
     const std::string uri = text.substr(open + 1, close - open - 1);
     if (uri.rfind("data:", 0) == 0 || !seen.insert(uri).second) continue;
-    const RegularFile file = statRegularFile(path.parent_path() / uri);
+    // A file outside the mesh's folder tree is not read (the load refuses it): not counted.
+    const std::filesystem::path named = path.parent_path() / uri;
+    if (!rule.refusal(named).empty()) continue;
+    const RegularFile file = statRegularFile(named);
     if (file.refusal == FileRefusal::None) total += file.size;
   }
   return total;
@@ -122,7 +126,8 @@ std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size) {
 
 }  // namespace
 
-MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path) {
+MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path,
+                                  const MeshReadOptions& options) {
   std::uint64_t size = 0;
   const std::string header = readHeader(path, size);
   const std::string extension = checkedExtension(path);
@@ -162,7 +167,7 @@ MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path) {
     return estimate;
   }
   if (extension == ".gltf" || extension == ".glb") {
-    estimate.triangles = gltfBytes(path, size) / 12;
+    estimate.triangles = gltfBytes(path, size, ReferencedFileRule(path, options.sceneFolder)) / 12;
     estimate.vertices = estimate.triangles / 2;
     return estimate;
   }

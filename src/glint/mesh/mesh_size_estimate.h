@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "glint/mesh/mesh_file.h"
+
 namespace glint {
 
 // From the header (PLY element counts, the binary STL triangle count), by counting lines without
@@ -18,7 +20,9 @@ struct MeshSizeEstimate {
 };
 
 // Throws MeshLoadError for the same unreadable files as readMeshFile (missing, folder, device,
-// extension, header counts the file cannot hold).
-MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path);
+// extension, header counts the file cannot hold). Files the mesh file names outside the folder
+// tree of `options` are not counted (readMeshFile refuses them).
+MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path,
+                                  const MeshReadOptions& options = {});
 
 }  // namespace glint
