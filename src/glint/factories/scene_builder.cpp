@@ -664,10 +664,11 @@ class Builder {
     std::shared_ptr<const MeshFile> file;
     try {
       // Estimated (mesh + BVH, with the film) against the memory limit before anything is read.
-      file = meshCache_.load(path,
-                             MeshBudget{options_.imageMemoryBudget,
-                                        filmBytes(parts_.image.width, parts_.image.height)},
-                             MeshReadOptions{.sceneFolder = d_.baseDirectory});
+      file = meshCache_.load(
+          path,
+          MeshBudget{options_.imageMemoryBudget,
+                     filmBytes(parts_.image.width, parts_.image.height)},
+          MeshReadOptions{.sceneFolder = d_.baseDirectory, .cancel = options_.cancel});
     } catch (const MeshLoadError& e) {
       std::string reason = e.what();
       if (path != written && reason == "no such file") {
@@ -694,7 +695,8 @@ class Builder {
                                    file->droppedTriangles == 1 ? "" : "s", triangles));
     }
     const bool smooth = o.smooth ? o.smooth->value : true;
-    std::vector<TriangleMesh> meshes = instantiateMesh(*file, worldFromFile, smooth);
+    std::vector<TriangleMesh> meshes =
+        instantiateMesh(*file, worldFromFile, smooth, options_.cancel);
     const std::vector<std::uint32_t>* scene = overridesMaterial ? nullptr : &fileMaterials(*file);
     for (TriangleMesh& mesh : meshes) {
       const MeshMaterial& own = file->materials[mesh.materialIndex];

@@ -4,6 +4,7 @@
 // problem at the place in the file it comes from. The only io code that creates render objects.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -21,6 +22,9 @@ struct BuildOptions {
   // The caller's replacements of the image size, samples and seed, applied before the film and the
   // meshes are estimated; the caller checks the overridden image against the limits.
   SceneOverrides overrides{};
+  // Polled while mesh files are read and instanced; when set the build throws Cancelled
+  // (core/cancel.h). Not owned; may be null.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct BuildResult {

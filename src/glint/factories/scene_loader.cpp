@@ -78,8 +78,8 @@ LoadedScene loadSceneFromString(std::string_view text, const std::string& displa
                                 const std::filesystem::path& baseDirectory,
                                 const LoadOptions& options) {
   ParseResult parsed = parseScene(text, displayName, baseDirectory);
-  BuildResult built =
-      buildScene(parsed.description, BuildOptions{options.memoryBudget, options.overrides});
+  BuildResult built = buildScene(
+      parsed.description, BuildOptions{options.memoryBudget, options.overrides, options.cancel});
 
   std::vector<Diagnostic> errors;
   std::vector<Diagnostic> warnings;

@@ -9,11 +9,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdint>
 #include <cstring>
+#include <ctime>
 #include <new>
 #include <optional>
 #include <string>
@@ -24,6 +26,7 @@
 
 #include <fmt/format.h>
 
+#include "glint/core/cancel.h"
 #include "glint/mesh/assimp_import.h"
 #include "glint/mesh/file_access.h"
 
@@ -85,18 +88,28 @@ bool writeMeshFile(int fd, const MeshFile& file) {
   return ok;
 }
 
-// Reads what the child sent, refusing anything inconsistent.
+// While waiting for the child, the parent looks at the cancel flag this often (milliseconds): a
+// cancelled load stops within about this time plus the kill of the child.
+constexpr int kCancelPollMilliseconds = 20;
+
+// The test hook's delay of the child (setImportChildDelayForTesting), in milliseconds.
+std::atomic<std::int64_t> gChildDelayMilliseconds{0};
+
 // Reads the child's answer, waiting at most until `deadline` for it: a reader that loops (as
-// assimp's importers have on malformed files) must not hang glint.
+// assimp's importers have on malformed files) must not hang glint. While waiting and between
+// reads it polls `cancel` and throws Cancelled when it is set.
 class Reader {
  public:
-  Reader(int fd, std::chrono::steady_clock::time_point deadline) : fd_(fd), deadline_(deadline) {}
+  Reader(int fd, std::chrono::steady_clock::time_point deadline, const std::atomic<bool>* cancel)
+      : fd_(fd), cancel_(cancel), deadline_(deadline) {}
   // Reads, from its start, a file the child has finished writing: nothing to wait for.
-  explicit Reader(int file) : fd_(file), file_(true) {}
+  Reader(int file, const std::atomic<bool>* cancel) : fd_(file), file_(true), cancel_(cancel) {}
   bool timedOut() const { return timedOut_; }
+  const std::atomic<bool>* cancel() const { return cancel_; }
   void bytes(void* data, std::size_t size) {
     char* p = static_cast<char*>(data);
     while (file_ && size > 0) {
+      throwIfCancelled(cancel_);
       const ssize_t n = ::pread(fd_, p, size, offset_);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) throw MeshLoadError("invalid file: the mesh reader stopped before its answer");
@@ -105,19 +118,19 @@ class Reader {
       size -= static_cast<std::size_t>(n);
     }
     while (size > 0) {
+      throwIfCancelled(cancel_);
       const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
           deadline_ - std::chrono::steady_clock::now());
-      pollfd ready{fd_, POLLIN, 0};
-      const int polled = left.count() > 0 ? ::poll(&ready, 1,
-                                                   static_cast<int>(std::min<std::int64_t>(
-                                                       left.count(), std::int64_t{1} << 30)))
-                                          : 0;
-      if (polled < 0 && errno == EINTR) continue;
-      if (polled == 0) {
+      if (left.count() <= 0) {
         timedOut_ = true;
         throw MeshLoadError("invalid file: the mesh library did not finish reading it within " +
                             formatSeconds(deadline_ - started_));
       }
+      pollfd ready{fd_, POLLIN, 0};
+      const int polled =
+          ::poll(&ready, 1,
+                 static_cast<int>(std::min<std::int64_t>(left.count(), kCancelPollMilliseconds)));
+      if ((polled < 0 && errno == EINTR) || polled == 0) continue;
       const ssize_t n = ::read(fd_, p, size);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0) throw MeshLoadError("invalid file: the mesh reader stopped before its answer");
@@ -153,6 +166,7 @@ class Reader {
   }
   int fd_;
   bool file_ = false;
+  const std::atomic<bool>* cancel_;
   off_t offset_ = 0;  // in a file
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point deadline_;
@@ -187,7 +201,13 @@ MeshFile receiveMeshFile(Reader& in) {
     bool ok = part.materialIndex < file.materials.size() && part.indices.size() % 3 == 0 &&
               (part.normals.empty() || part.normals.size() == part.positions.size()) &&
               triangles <= kMaxMeshTriangles;
-    for (const std::uint32_t i : part.indices) ok = ok && i < part.positions.size();
+    // In blocks, polling the cancel flag between them: a mesh may hold hundreds of millions.
+    constexpr std::size_t kBlock = std::size_t{1} << 20;
+    for (std::size_t begin = 0; ok && begin < part.indices.size(); begin += kBlock) {
+      throwIfCancelled(in.cancel());
+      const std::size_t end = std::min(part.indices.size(), begin + kBlock);
+      for (std::size_t k = begin; k < end; ++k) ok = ok && part.indices[k] < part.positions.size();
+    }
     if (!ok) throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
   }
   return file;
@@ -205,8 +225,12 @@ std::chrono::steady_clock::duration meshReadTimeLimit(const std::filesystem::pat
 
 }  // namespace
 
+void setImportChildDelayForTesting(std::chrono::milliseconds delay) {
+  gChildDelayMilliseconds.store(delay.count());
+}
+
 MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension,
-                           const ReferencedFileRule& rule) {
+                           const ReferencedFileRule& rule, const std::atomic<bool>* cancel) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw MeshLoadError(systemReason(errno));
   // The answer travels in a memory file when it can: the child writes it whole without waiting for
@@ -238,6 +262,15 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
     // ends with _exit, so its heap is never given back in any case.
     ::mallopt(M_MMAP_THRESHOLD, 32 << 20);
     ::signal(SIGXFSZ, SIG_IGN);  // a write past a file size limit fails instead
+    // Ctrl-C reaches the whole process group, the child too. Its fate is the parent's: a parent
+    // that handles the signal cancels the load and kills the child, one that dies of it takes the
+    // child along (PR_SET_PDEATHSIG); the child dying of it on its own would read as a crash.
+    for (const int stop : {SIGINT, SIGTERM, SIGHUP}) ::signal(stop, SIG_IGN);
+    if (const std::int64_t delay = gChildDelayMilliseconds.load(); delay > 0) {
+      const timespec pause{static_cast<time_t>(delay / 1000),
+                           static_cast<long>(delay % 1000) * 1000000};
+      ::nanosleep(&pause, nullptr);
+    }
     MeshFile result;
     std::string error;
     try {
@@ -266,11 +299,12 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
   ::close(fds[1]);
   std::optional<MeshFile> file;
   std::string failure;
-  Reader in(fds[0], std::chrono::steady_clock::now() + meshReadTimeLimit(path));
+  bool cancelled = false;
+  Reader in(fds[0], std::chrono::steady_clock::now() + meshReadTimeLimit(path), cancel);
   try {
     const char where = in.value<char>();
     if (where == 'D' && answer >= 0) {
-      Reader written(answer);
+      Reader written(answer, cancel);
       file = receiveMeshFile(written);
     } else if (where == 'P') {
       file = receiveMeshFile(in);
@@ -281,13 +315,16 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
     failure = e.what();
   } catch (const std::bad_alloc&) {
     failure = "not enough memory to load it";
+  } catch (const Cancelled&) {
+    cancelled = true;
   }
   ::close(fds[0]);  // a child still writing gets EPIPE and ends
   if (answer >= 0) ::close(answer);
-  if (in.timedOut()) ::kill(pid, SIGKILL);
+  if (in.timedOut() || cancelled) ::kill(pid, SIGKILL);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
+  if (cancelled) throw Cancelled();
   if (in.timedOut()) throw MeshLoadError(failure);
   // SIGPIPE: the child was still writing when the parent stopped reading an inconsistent answer.
   if (WIFSIGNALED(status) && WTERMSIG(status) != SIGPIPE) {

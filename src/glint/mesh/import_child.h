@@ -4,6 +4,8 @@
 // Internal to the mesh loader.
 #pragma once
 
+#include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <string>
 
@@ -20,8 +22,14 @@ inline constexpr double kMeshReadSecondsPerMiB = 2;
 
 // importMesh (assimp_import.h) run in a child process; the parent checks the answer (sizes,
 // indices, materials) before returning it. A crash of the child, an answer cut short or
-// inconsistent, or the time limit is a MeshLoadError.
+// inconsistent, or the time limit is a MeshLoadError. While it waits for the child and checks the
+// answer, the parent polls `cancel` (may be null): once it is set the child is killed at once and
+// Cancelled (core/cancel.h) thrown, within ~20 ms.
 MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension,
-                           const ReferencedFileRule& rule);
+                           const ReferencedFileRule& rule, const std::atomic<bool>* cancel);
+
+// For tests of the parent's waiting (cancellation, time limit): every child started from now on
+// sleeps `delay` before it reads the file; zero turns it off.
+void setImportChildDelayForTesting(std::chrono::milliseconds delay);
 
 }  // namespace glint

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "glint/core/cancel.h"
 #include "glint/mesh/file_access.h"
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/mesh_size_estimate.h"
@@ -40,12 +41,14 @@ std::shared_ptr<const MeshFile> MeshCache::read(const std::filesystem::path& key
 
 std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path,
                                                 const MeshReadOptions& options) {
+  throwIfCancelled(options.cancel);
   return read(keyOf(path), path, options);
 }
 
 std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path,
                                                 const MeshBudget& budget,
                                                 const MeshReadOptions& options) {
+  throwIfCancelled(options.cancel);
   const std::filesystem::path key = keyOf(path);
   const auto it = entries_.find(key);
   if (it != entries_.end() && !it->second.file) throw MeshLoadError(it->second.error);

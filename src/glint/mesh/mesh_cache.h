@@ -49,8 +49,9 @@ class MeshTooLargeError : public MeshLoadError {
 // are one file. A failure is remembered too and thrown again. One cache lives for one scene load.
 class MeshCache {
  public:
-  // The file's content, shared by every caller asking for the same file. Throws MeshLoadError.
-  // The options of the first read of a file hold for the cache's life: one cache, one scene.
+  // The file's content, shared by every caller asking for the same file. Throws MeshLoadError, or
+  // Cancelled when options.cancel is set (not remembered). The options of the first read of a
+  // file hold for the cache's life: one cache, one scene.
   std::shared_ptr<const MeshFile> load(const std::filesystem::path& path,
                                        const MeshReadOptions& options = {});
   // The same, counted against `budget` as one more mesh object. Throws MeshTooLargeError (not

@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include "glint/core/cancel.h"
 #include "glint/mesh/file_access.h"
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/import_child.h"
@@ -21,17 +22,19 @@ double meshCopyBytes(double triangles, double vertices) {
 }
 
 MeshFile readMeshFile(const std::filesystem::path& path, const MeshReadOptions& options) {
+  throwIfCancelled(options.cancel);
   std::uint64_t size = 0;
   const std::string header = readHeader(path, size);
   const std::string extension = checkedExtension(path);
   if (extension == ".ply") checkPlyHeader(header, size);
   if (extension == ".gltf" || extension == ".glb") checkGltfPrimitives(path, extension, size);
-  return importMeshInChild(path, extension, ReferencedFileRule(path, options.sceneFolder));
+  return importMeshInChild(path, extension, ReferencedFileRule(path, options.sceneFolder),
+                           options.cancel);
 }
 
 std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
                                           const std::optional<Transform>& worldFromFile,
-                                          bool smooth) {
+                                          bool smooth, const std::atomic<bool>* cancel) {
   bool mirror = false;
   if (worldFromFile) {
     const auto& m = worldFromFile->matrix().m;
@@ -42,7 +45,10 @@ std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
   }
   std::vector<TriangleMesh> out;
   out.reserve(file.parts.size());
+  // Vertices transformed between two looks at the cancel flag (a few milliseconds).
+  constexpr std::size_t kBlock = std::size_t{1} << 16;
   for (const TriangleMesh& part : file.parts) {
+    throwIfCancelled(cancel);
     TriangleMesh mesh;
     mesh.materialIndex = part.materialIndex;
     mesh.emission = part.emission;
@@ -58,10 +64,16 @@ std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
     } else {
       const Transform& t = *worldFromFile;
       mesh.positions.reserve(part.positions.size());
-      for (const Point3& p : part.positions) mesh.positions.push_back(t(p));
+      for (const Point3& p : part.positions) {
+        if (mesh.positions.size() % kBlock == 0) throwIfCancelled(cancel);
+        mesh.positions.push_back(t(p));
+      }
       if (smooth) {
         mesh.normals.reserve(part.normals.size());
-        for (const Normal3& n : part.normals) mesh.normals.push_back(normalize(t(n)));
+        for (const Normal3& n : part.normals) {
+          if (mesh.normals.size() % kBlock == 0) throwIfCancelled(cancel);
+          mesh.normals.push_back(normalize(t(n)));
+        }
       }
     }
     out.push_back(std::move(mesh));

@@ -3,6 +3,7 @@
 // world space for one mesh object (DESIGN.md §5 `mesh`).
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -91,7 +92,11 @@ struct MeshReadOptions {
   // The scene file's folder. The files a mesh file names (MTL libraries, glTF buffers and images)
   // must lie in this folder or below, or, for a mesh file outside it, in the mesh file's own
   // folder or below; empty: always the mesh file's own folder (ReferencedFileRule, file_access.h).
-  std::filesystem::path sceneFolder;
+  std::filesystem::path sceneFolder{};
+  // Polled while the file is read (waiting for the import child, checking its answer, scanning the
+  // file for the estimate); once set, the child is killed at once and the read throws Cancelled
+  // (core/cancel.h). Not owned; may be null.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 // Reads and converts a mesh file. Throws MeshLoadError: no such file, a folder or other non-regular
@@ -104,7 +109,8 @@ struct MeshReadOptions {
 // PLY header must end (end_header) within 64 KiB; a glTF strip or fan primitive needs its vertices.
 // assimp runs in a child process (fork) that sends the result back through a pipe: fuzzing found
 // memory corruption inside assimp 5.2's importers, which there becomes a refused file ("the mesh
-// library crashed reading it") instead of a crashed or corrupted renderer.
+// library crashed reading it") instead of a crashed or corrupted renderer. Throws Cancelled when
+// options.cancel is set.
 MeshFile readMeshFile(const std::filesystem::path& path, const MeshReadOptions& options = {});
 
 // The world-space meshes of one mesh object: every part of `file` with `worldFromFile` applied —
@@ -112,9 +118,10 @@ MeshFile readMeshFile(const std::filesystem::path& path, const MeshReadOptions& 
 // mirrors (negative determinant) also reverses each triangle's index order so the geometric normal
 // (right-hand rule) keeps its side relative to the vertex normals. Without `smooth` the normals are
 // dropped (flat shading). Material indices and emission are copied from the file; the caller maps
-// them onto the scene's materials.
+// them onto the scene's materials. Polls `cancel` (may be null) as it goes and throws Cancelled
+// once it is set.
 std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
                                           const std::optional<Transform>& worldFromFile,
-                                          bool smooth);
+                                          bool smooth, const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace glint

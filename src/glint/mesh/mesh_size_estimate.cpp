@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <set>
@@ -10,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "glint/core/cancel.h"
 #include "glint/mesh/file_access.h"
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/mesh_file.h"
@@ -21,11 +23,13 @@ namespace {
 // Calls `line` with every line of the file (without its '\n'), reading 64 KiB at a time and keeping
 // at most kMaxScannedLine bytes of a line: counting needs no more, and memory stays bounded for any
 // file. Lines are found with memchr and passed as views into the buffer; only a line that spans two
-// reads is copied. Throws MeshLoadError when the file cannot be read.
+// reads is copied. Throws MeshLoadError when the file cannot be read, Cancelled once `cancel` (may
+// be null; polled before every read) is set.
 constexpr std::size_t kMaxScannedLine = 256;
 
 template <typename LineFn>
-void forEachLine(const std::filesystem::path& path, LineFn&& line) {
+void forEachLine(const std::filesystem::path& path, const std::atomic<bool>* cancel,
+                 LineFn&& line) {
   const RegularFile file = openMeshFile(path);
   const int fd = file.handle.get();
   std::string carried;  // the start of a line that continues in the next read
@@ -35,6 +39,7 @@ void forEachLine(const std::filesystem::path& path, LineFn&& line) {
   };
   std::vector<char> buffer(std::size_t{1} << 16);
   for (;;) {
+    throwIfCancelled(cancel);
     const ssize_t n = ::read(fd, buffer.data(), buffer.size());
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) throw MeshLoadError(systemReason(errno));
@@ -148,14 +153,14 @@ MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path,
         return {count, count / 2};
       }
     }
-    forEachLine(path, [&](std::string_view line) {
+    forEachLine(path, options.cancel, [&](std::string_view line) {
       if (firstWord(line) == "facet") ++estimate.triangles;
     });
     estimate.vertices = estimate.triangles / 2;
     return estimate;
   }
   if (extension == ".obj") {
-    forEachLine(path, [&](std::string_view line) {
+    forEachLine(path, options.cancel, [&](std::string_view line) {
       const std::string_view word = firstWord(line);
       if (word == "v") {
         ++estimate.vertices;

@@ -21,7 +21,8 @@ struct MeshSizeEstimate {
 
 // Throws MeshLoadError for the same unreadable files as readMeshFile (missing, folder, device,
 // extension, header counts the file cannot hold). Files the mesh file names outside the folder
-// tree of `options` are not counted (readMeshFile refuses them).
+// tree of `options` are not counted (readMeshFile refuses them). Throws Cancelled once
+// options.cancel is set (polled while the file is scanned).
 MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path,
                                   const MeshReadOptions& options = {});
 
