@@ -13,6 +13,10 @@
 
 namespace glint {
 
+double meshInstanceBytes(double triangles, double vertices) {
+  return meshCopyBytes(triangles, vertices) + kBvhBuildBytesPerTriangle * triangles;
+}
+
 std::filesystem::path MeshCache::keyOf(const std::filesystem::path& path) {
   std::error_code error;
   std::filesystem::path key = std::filesystem::weakly_canonical(path, error);
@@ -77,8 +81,9 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
     }
     const double triangles = static_cast<double>(size.triangles);
     const double vertices = static_cast<double>(size.vertices);
-    // The cached file, this object's world copy and its share of the BVH.
-    const double bytes = 2 * meshCopyBytes(triangles, vertices) + kBvhBytesPerTriangle * triangles;
+    // The cached file, this object's world copy and its share of the BVH build.
+    const double bytes =
+        meshCopyBytes(triangles, vertices) + meshInstanceBytes(triangles, vertices);
     const double total = meshBytes_ + bytes + static_cast<double>(budget.otherBytes);
     if (total > static_cast<double>(budget.limit)) {
       throw MeshTooLargeError(fmt::format(
@@ -98,16 +103,19 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
     triangles += static_cast<double>(part.triangleCount());
     vertices += static_cast<double>(part.positions.size());
   }
-  const double copy = meshCopyBytes(triangles, vertices);
-  const double bytes = (cached ? copy : 2 * copy) + kBvhBytesPerTriangle * triangles;
-  if (cached && meshBytes_ + bytes + static_cast<double>(budget.otherBytes) >
-                    static_cast<double>(budget.limit)) {
+  const double bytes =
+      (cached ? 0 : meshCopyBytes(triangles, vertices)) + meshInstanceBytes(triangles, vertices);
+  if (meshBytes_ + bytes + static_cast<double>(budget.otherBytes) >
+      static_cast<double>(budget.limit)) {
+    const std::string what =
+        cached ? fmt::format("another instance of its {} triangles needs about {} with its BVH",
+                             formatCount(triangles), formatBytes(bytes))
+               : fmt::format("its {} triangles need about {} as a mesh and its BVH",
+                             formatCount(triangles), formatBytes(bytes));
     throw MeshTooLargeError(fmt::format(
-        "another instance of its {} triangles needs about {} with its BVH; with {} already "
-        "committed (the image's film and the meshes before it) that is more than the memory limit "
-        "of {}",
-        formatCount(triangles), formatBytes(bytes),
-        formatBytes(meshBytes_ + static_cast<double>(budget.otherBytes)),
+        "{}; with {} already committed (the image's film and the meshes before it) that is more "
+        "than the memory limit of {}",
+        what, formatBytes(meshBytes_ + static_cast<double>(budget.otherBytes)),
         formatBytes(static_cast<double>(budget.limit))));
   }
   meshBytes_ += bytes;

@@ -13,27 +13,49 @@
 
 namespace glint {
 
-// Memory model of a mesh for the estimate checked before loading (DESIGN.md §7): glint keeps the
-// file's triangles (MeshFile, in the MeshCache) and, per mesh object, a world-space copy that the
-// Aggregate then owns; each copy is meshCopyBytes (mesh_file.h). The 4-wide BVH adds about
-// kBvhBytesPerTriangle (nodes and leaf references: measured 58 B per triangle for mesh + tree with
-// 0.5 vertices per triangle, i.e. 36 B of mesh and 22 B of tree; bench/build_memory).
-inline constexpr double kBvhBytesPerTriangle = 22;
+// Memory model of a mesh object, checked before its file is read (DESIGN.md §7). The peak comes
+// while the scene's BVH is built (accel/aggregate.cpp, accel/bvh4.cpp), when glint holds for every
+// mesh object its world-space copy (meshCopyBytes, mesh_file.h; the Aggregate keeps it) and its
+// share of the build, kBvhBuildBytesPerTriangle:
+//  - kBvhReferenceBytesPerTriangle: one bvh::BuildItem per triangle, held until the tree is built;
+//  - the tree's 128 B nodes twice over, while bvh::build copies them into an array of their exact
+//    size. Connected surfaces (modelled and scanned meshes, scenes/meshes/torus_knot.obj) take
+//    17–19 B of nodes per triangle, a soup of tiny disconnected triangles up to 37 B:
+//    kBvhNodeBytesPerTriangle allows for that.
+// While it reads the files the MeshCache also holds each file's own copy once (meshCopyBytes),
+// which the estimate counts too (the Aggregate's reordering holds a second copy of a mesh for a
+// moment). Measured with `glint check` on N copies of torus_knot.obj (38,400 triangles, 19,200
+// vertices): the peak resident memory grows by 4.1–4.2 MB per copy, 1.4 MB of them the world
+// copy; the estimate is 5.4 MB. After the build the tree keeps ~18 B per triangle.
+inline constexpr double kBvhReferenceBytesPerTriangle = 32;
+inline constexpr double kBvhNodeBytesPerTriangle = 36;
+inline constexpr double kBvhBuildBytesPerTriangle =
+    kBvhReferenceBytesPerTriangle + 2 * kBvhNodeBytesPerTriangle;
 
-// An upper bound of what an OBJ's or STL's estimate can count against a budget (the cached copy,
-// the world copy and the BVH: 96 B per vertex, 46 B per triangle) per byte of the file: a counted
-// `v` line takes at least 2 bytes ("v" and its newline), an `f` line of c corners at least 2c + 2
-// for its c − 2 triangles, an ASCII STL `facet` line 6, a binary STL triangle 50. MeshCache skips
-// the estimate's scan of the file when kMeshBudgetBytesPerFileByte × size + one vertex
-// (kMeshBudgetSlackBytes, for a last line without its newline) already fits the budget.
-inline constexpr double kMeshBudgetBytesPerFileByte = 48;
-inline constexpr double kMeshBudgetSlackBytes = 96;
+// Bytes one more mesh object of that size adds at the peak: its world copy and its share of the
+// BVH build.
+double meshInstanceBytes(double triangles, double vertices);
+
+// An upper bound of what an OBJ's or STL's estimate can count against a budget per byte of the
+// file: the cached copy, the world copy and the BVH build count 2 × kMeshBytesPerVertex = 96 B
+// per vertex and 2 × kMeshBytesPerTriangle + kBvhBuildBytesPerTriangle = 128 B per triangle; a
+// counted `v` line takes at least 2 bytes ("v" and its newline), an `f` line of c corners at
+// least 2c + 2 for its c − 2 triangles (toward 2 bytes per triangle as c grows), an ASCII STL
+// `facet` line 6, a binary STL triangle 50. MeshCache skips the estimate's scan of the file when
+// kMeshBudgetBytesPerFileByte × size + one vertex (kMeshBudgetSlackBytes, for a last line without
+// its newline) already fits the budget.
+inline constexpr double kMeshBudgetBytesPerFileByte =
+    (2 * kMeshBytesPerTriangle + kBvhBuildBytesPerTriangle) / 2 > kMeshBytesPerVertex
+        ? (2 * kMeshBytesPerTriangle + kBvhBuildBytesPerTriangle) / 2
+        : kMeshBytesPerVertex;
+inline constexpr double kMeshBudgetSlackBytes = 2 * kMeshBytesPerVertex;
 
 // With a MeshBudget, every load also counts toward the scene's memory estimate: a file not yet read
-// is estimated (estimateMeshSize) — its cached copy, the object's world copy and the BVH's share —
-// and refused with MeshTooLargeError before anything of it is read when the meshes so far, this
-// one and the budget's other bytes (the film) would exceed the limit. After the read the estimate
-// is replaced by the real sizes.
+// is estimated (estimateMeshSize) — its cached copy, the object's world copy and the BVH build's
+// share — and refused with MeshTooLargeError before anything of it is read when the meshes so far,
+// this one and the budget's other bytes (the film) would exceed the limit. After the read the
+// real sizes replace the estimate and are checked again, before the world copy is made; every
+// further object using the file counts one more instance (meshInstanceBytes).
 struct MeshBudget {
   std::uint64_t limit = 0;       // bytes: LoadOptions::memoryBudget (--max-memory)
   std::uint64_t otherBytes = 0;  // bytes committed outside meshes: the film
@@ -60,7 +82,8 @@ class MeshCache {
                                        const MeshReadOptions& options = {});
   // Files actually read (not served from the cache).
   std::size_t filesRead() const { return filesRead_; }
-  // Estimated bytes of every mesh loaded with a budget so far: cached files, world copies, BVH.
+  // Estimated bytes of every mesh loaded with a budget so far: cached files, world copies, BVH
+  // build.
   double meshBytes() const { return meshBytes_; }
 
  private:
