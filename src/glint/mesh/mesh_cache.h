@@ -24,9 +24,12 @@ namespace glint {
 //    kBvhNodeBytesPerTriangle allows for that.
 // While it reads the files the MeshCache also holds each file's own copy once (meshCopyBytes),
 // which the estimate counts too (the Aggregate's reordering holds a second copy of a mesh for a
-// moment). Measured with `glint check` on N copies of torus_knot.obj (38,400 triangles, 19,200
-// vertices): the peak resident memory grows by 4.1–4.2 MB per copy, 1.4 MB of them the world
-// copy; the estimate is 5.4 MB. After the build the tree keeps ~18 B per triangle.
+// moment). Measured with `glint check` on 2 CPUs for N copies of torus_knot.obj (38,400
+// triangles, 19,200 vertices): the peak resident memory grows by 4.1–4.6 MB per copy, 1.4 MB of
+// them the world copy; the estimate is 5.4 MB. The build's peak grows with its threads (buffers
+// freed in per-thread heaps are not given back): a 40,000-triangle grid peaks at 4.5 MB per copy
+// on one CPU, 5.1 MB on two, against 5.7 MB estimated. After the build the tree keeps ~18 B per
+// triangle.
 inline constexpr double kBvhReferenceBytesPerTriangle = 32;
 inline constexpr double kBvhNodeBytesPerTriangle = 36;
 inline constexpr double kBvhBuildBytesPerTriangle =
