@@ -127,9 +127,10 @@ class Reader {
                             formatSeconds(deadline_ - started_));
       }
       pollfd ready{fd_, POLLIN, 0};
-      const int polled =
-          ::poll(&ready, 1,
-                 static_cast<int>(std::min<std::int64_t>(left.count(), kCancelPollMilliseconds)));
+      // Without a cancel flag there is nothing to look at until the deadline.
+      const std::int64_t wait = std::min<std::int64_t>(
+          left.count(), cancel_ != nullptr ? kCancelPollMilliseconds : std::int64_t{1} << 30);
+      const int polled = ::poll(&ready, 1, static_cast<int>(wait));
       if ((polled < 0 && errno == EINTR) || polled == 0) continue;
       const ssize_t n = ::read(fd_, p, size);
       if (n < 0 && errno == EINTR) continue;
