@@ -56,19 +56,18 @@ class MeshFileAccess : public Assimp::DefaultIOSystem {
       return nullptr;
     }
     if (refused(rule_.refusal(file))) return nullptr;
-    RegularFile opened = openRegularFile(file);
-    if (!accepted(file, opened) || refused(rule_.openedRefusal(opened.handle.get(), file))) {
+    ReadableFile opened = openForReading(file);
+    if (!accepted(file, opened) || refused(rule_.openedRefusal(opened.fd, file))) {
       return nullptr;
     }
-    FILE* stream = ::fdopen(opened.handle.get(), "rb");
+    FILE* stream = ::fdopen(opened.fd, "rb");
     if (stream == nullptr) return nullptr;
-    opened.handle.release();  // the stream closes it
+    opened.release();  // the stream closes it
     return new OpenedFileStream(stream, file);
   }
   // DefaultIOSystem::Exists opens the file with fopen, which blocks on a FIFO.
   bool Exists(const char* file) const override {
-    return file != nullptr && !refused(rule_.refusal(file)) &&
-           accepted(file, statRegularFile(file));
+    return file != nullptr && !refused(rule_.refusal(file)) && accepted(file, statForReading(file));
   }
 
   // Why a file the mesh file names refuses it ("" when none did), in the user's words.
@@ -80,7 +79,7 @@ class MeshFileAccess : public Assimp::DefaultIOSystem {
     if (!why.empty() && refusal_.empty()) refusal_ = why;
     return !why.empty();
   }
-  bool accepted(const char* file, const RegularFile& found) const {
+  bool accepted(const char* file, const ReadableFile& found) const {
     if (found.refusal == FileRefusal::NotRegular) {
       refused(rule_.isMeshFile(file)
                   ? std::string("it is not a regular file")

@@ -21,16 +21,22 @@ std::string systemReason(int error) {
   return text;
 }
 
-FileHandle& FileHandle::operator=(FileHandle&& other) noexcept {
+ReadableFile::ReadableFile(ReadableFile&& other) noexcept
+    : fd(other.release()), size(other.size), refusal(other.refusal), error(other.error) {}
+
+ReadableFile& ReadableFile::operator=(ReadableFile&& other) noexcept {
   if (this != &other) {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = std::exchange(other.fd_, -1);
+    if (fd >= 0) ::close(fd);
+    fd = other.release();
+    size = other.size;
+    refusal = other.refusal;
+    error = other.error;
   }
   return *this;
 }
 
-FileHandle::~FileHandle() {
-  if (fd_ >= 0) ::close(fd_);
+ReadableFile::~ReadableFile() {
+  if (fd >= 0) ::close(fd);
 }
 
 namespace {
@@ -42,8 +48,8 @@ FileRefusal refusalOf(const struct stat& info) {
   return FileRefusal::None;
 }
 
-RegularFile failed(int error) {
-  RegularFile file;
+ReadableFile failed(int error) {
+  ReadableFile file;
   file.refusal = error == ENOENT ? FileRefusal::Missing : FileRefusal::System;
   file.error = error;
   return file;
@@ -51,32 +57,34 @@ RegularFile failed(int error) {
 
 }  // namespace
 
-RegularFile statRegularFile(const std::filesystem::path& path) {
+ReadableFile statForReading(const std::filesystem::path& path) {
   struct stat info {};
   if (::stat(path.c_str(), &info) != 0) return failed(errno);
-  RegularFile file;
+  ReadableFile file;
   file.refusal = refusalOf(info);
   file.size = static_cast<std::uint64_t>(info.st_size);
   return file;
 }
 
-RegularFile openRegularFile(const std::filesystem::path& path) {
-  RegularFile file = statRegularFile(path);
+ReadableFile openForReading(const std::filesystem::path& path) {
+  ReadableFile file = statForReading(path);
   if (file.refusal != FileRefusal::None) return file;
-  FileHandle handle(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
-  if (!handle) return failed(errno);
+  file.fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (file.fd < 0) return failed(errno);
   struct stat info {};
-  if (::fstat(handle.get(), &info) != 0) return failed(errno);
+  if (::fstat(file.fd, &info) != 0) return failed(errno);
   file.refusal = refusalOf(info);
-  if (file.refusal != FileRefusal::None) return file;
-  const int flags = ::fcntl(handle.get(), F_GETFL);
-  if (flags < 0 || ::fcntl(handle.get(), F_SETFL, flags & ~O_NONBLOCK) != 0) return failed(errno);
+  if (file.refusal != FileRefusal::None) {
+    ::close(file.release());
+    return file;
+  }
+  const int flags = ::fcntl(file.fd, F_GETFL);
+  if (flags < 0 || ::fcntl(file.fd, F_SETFL, flags & ~O_NONBLOCK) != 0) return failed(errno);
   file.size = static_cast<std::uint64_t>(info.st_size);
-  file.handle = std::move(handle);
   return file;
 }
 
-std::string meshFileRefusal(const RegularFile& file) {
+std::string meshFileRefusal(const ReadableFile& file) {
   switch (file.refusal) {
     case FileRefusal::None:
       return "";
@@ -92,8 +100,8 @@ std::string meshFileRefusal(const RegularFile& file) {
   return systemReason(file.error);
 }
 
-RegularFile openMeshFile(const std::filesystem::path& path) {
-  RegularFile file = openRegularFile(path);
+ReadableFile openMeshFile(const std::filesystem::path& path) {
+  ReadableFile file = openForReading(path);
   if (file.refusal != FileRefusal::None) throw MeshLoadError(meshFileRefusal(file));
   return file;
 }

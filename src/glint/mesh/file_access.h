@@ -17,26 +17,6 @@ namespace glint {
 // The system's words for an errno, starting lower-case to follow "cannot load mesh file 'x': ".
 std::string systemReason(int error);
 
-// A file descriptor, closed when it goes out of scope.
-class FileHandle {
- public:
-  FileHandle() = default;
-  explicit FileHandle(int fd) : fd_(fd) {}
-  FileHandle(FileHandle&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
-  FileHandle& operator=(FileHandle&& other) noexcept;
-  FileHandle(const FileHandle&) = delete;
-  FileHandle& operator=(const FileHandle&) = delete;
-  ~FileHandle();
-
-  int get() const { return fd_; }
-  // Hands the descriptor over (to fdopen, say); the handle no longer closes it.
-  int release() { return std::exchange(fd_, -1); }
-  explicit operator bool() const { return fd_ >= 0; }
-
- private:
-  int fd_ = -1;
-};
-
 // Why a path cannot be read as a regular file.
 enum class FileRefusal {
   None,        // a regular file
@@ -46,26 +26,37 @@ enum class FileRefusal {
   System,      // stat or open failed otherwise (permission, ...): see `error`
 };
 
-struct RegularFile {
-  FileHandle handle;  // open for reading (blocking), close-on-exec; empty unless refusal is None
+// A path stat'ed or opened for reading: its size, or why it cannot be read. An opened file's
+// descriptor is closed when the ReadableFile goes out of scope.
+struct ReadableFile {
+  int fd = -1;  // open for reading (blocking, close-on-exec) when opened and refusal is None
   std::uint64_t size = 0;  // bytes
   FileRefusal refusal = FileRefusal::None;
   int error = 0;  // errno for Missing and System
+
+  ReadableFile() = default;
+  ReadableFile(ReadableFile&& other) noexcept;
+  ReadableFile& operator=(ReadableFile&& other) noexcept;
+  ReadableFile(const ReadableFile&) = delete;
+  ReadableFile& operator=(const ReadableFile&) = delete;
+  ~ReadableFile();
+  // Hands the descriptor over (to fdopen, say): it is no longer closed here.
+  int release() { return std::exchange(fd, -1); }
 };
 
-// What stat says of `path` (handle left empty): its size, or why it is refused.
-RegularFile statRegularFile(const std::filesystem::path& path);
+// What stat says of `path` (nothing opened): its size, or why it is refused.
+ReadableFile statForReading(const std::filesystem::path& path);
 
-// statRegularFile, then the file opened with O_NONBLOCK and checked again with fstat (O_NONBLOCK
+// statForReading, then the file opened with O_NONBLOCK and checked again with fstat (O_NONBLOCK
 // is cleared before returning).
-RegularFile openRegularFile(const std::filesystem::path& path);
+ReadableFile openForReading(const std::filesystem::path& path);
 
 // The reason a mesh file is refused, in the user's words: "no such file", "it is a folder, not a
 // mesh file", "it is not a regular file", or the system's reason.
-std::string meshFileRefusal(const RegularFile& file);
+std::string meshFileRefusal(const ReadableFile& file);
 
-// openRegularFile for a mesh file itself: a refusal throws MeshLoadError (meshFileRefusal).
-RegularFile openMeshFile(const std::filesystem::path& path);
+// openForReading for a mesh file itself: a refusal throws MeshLoadError (meshFileRefusal).
+ReadableFile openMeshFile(const std::filesystem::path& path);
 
 // The folder tree that the files a mesh file names (MTL libraries, glTF buffers and images, and
 // texture files) must lie in: the scene file's folder when the mesh file lies in it, else (and

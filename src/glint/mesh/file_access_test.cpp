@@ -104,16 +104,16 @@ TEST_F(MeshReferencedFiles, WhereAnOpenedFileReallyLeadsIsCheckedAgain) {
   // A link replaced between the check of its name and the open (a race the checks before opening
   // cannot see) is caught on the descriptor.
   const ReferencedFileRule rule(scene_ / "m.gltf", scene_);
-  const RegularFile outside = openRegularFile(dir_.path() / "outside.bin");
-  ASSERT_TRUE(outside.handle);
-  EXPECT_EQ(rule.openedRefusal(outside.handle.get(), scene_ / "swapped.bin"),
+  const ReadableFile outside = openForReading(dir_.path() / "outside.bin");
+  ASSERT_GE(outside.fd, 0);
+  EXPECT_EQ(rule.openedRefusal(outside.fd, scene_ / "swapped.bin"),
             fmt::format("it refers to 'swapped.bin', which leads to '{}' outside the folder '{}' "
                         "through a symbolic link (a mesh file may only name files in its scene "
                         "file's folder and below)",
                         (dir_.path() / "outside.bin").string(), scene_.string()));
-  const RegularFile inside = openRegularFile(scene_ / "inside.bin");
-  ASSERT_TRUE(inside.handle);
-  EXPECT_EQ(rule.openedRefusal(inside.handle.get(), scene_ / "inside.bin"), "");
+  const ReadableFile inside = openForReading(scene_ / "inside.bin");
+  ASSERT_GE(inside.fd, 0);
+  EXPECT_EQ(rule.openedRefusal(inside.fd, scene_ / "inside.bin"), "");
 }
 
 TEST_F(MeshReferencedFiles, AnObjMaterialLibraryOutsideIsRefused) {

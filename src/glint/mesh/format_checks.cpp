@@ -20,15 +20,15 @@
 namespace glint {
 
 std::string readHeader(const std::filesystem::path& path, std::uint64_t& size) {
-  const RegularFile checked = statRegularFile(path);
+  const ReadableFile checked = statForReading(path);
   if (checked.refusal != FileRefusal::None) throw MeshLoadError(meshFileRefusal(checked));
   checkedExtension(path);  // before the file is opened
-  const RegularFile file = openMeshFile(path);
+  const ReadableFile file = openMeshFile(path);
   size = file.size;
-  std::string header(kHeaderBytes, '\0');
+  std::string header(kMeshHeaderBytes, '\0');
   std::size_t filled = 0;
   while (filled < header.size()) {
-    const ssize_t n = ::read(file.handle.get(), header.data() + filled, header.size() - filled);
+    const ssize_t n = ::read(file.fd, header.data() + filled, header.size() - filled);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;
     filled += static_cast<std::size_t>(n);
@@ -159,7 +159,7 @@ PlyElementCounts checkPlyHeader(const std::string& header, std::uint64_t size) {
   if (!ended || !formatSeen) {
     throw MeshLoadError(fmt::format(
         "its PLY header has no {} line in its first {} (a damaged or truncated file)",
-        formatSeen ? "end_header" : "format", formatBytes(static_cast<double>(kHeaderBytes))));
+        formatSeen ? "end_header" : "format", formatBytes(static_cast<double>(kMeshHeaderBytes))));
   }
   refuseCounts(needed, size, declared + " elements");
   return PlyElementCounts{static_cast<std::uint64_t>(faceCount),
@@ -200,8 +200,8 @@ void checkGltfPrimitives(const std::filesystem::path& path, const std::string& e
                          std::uint64_t size) {
   std::string text;
   {
-    const RegularFile file = openMeshFile(path);
-    const int fd = file.handle.get();
+    const ReadableFile file = openMeshFile(path);
+    const int fd = file.fd;
     std::uint64_t want = size;
     if (extension == ".glb") {
       // 12-byte header ("glTF", version, length), then the JSON chunk: length, "JSON", data.

@@ -19,7 +19,7 @@ namespace glint {
 inline constexpr const char* kMeshExtensions[] = {".obj", ".ply", ".stl", ".gltf", ".glb"};
 
 // Bytes of a mesh file's start that readHeader returns, and within which a PLY header must end.
-inline constexpr std::size_t kHeaderBytes = 64 * 1024;
+inline constexpr std::size_t kMeshHeaderBytes = 64 * 1024;
 
 // The path's extension in lower case ("" when it has none).
 std::string lowerExtension(const std::filesystem::path& path);
@@ -30,7 +30,7 @@ std::string checkedExtension(const std::filesystem::path& path);
 // Fails early, with the system's reason, for what assimp would only call "Unable to open file":
 // a missing path, a folder, a device or pipe (which could block or never end), an extension glint
 // does not read (checked before opening), no permission.
-// Returns the file's first bytes (at most kHeaderBytes) and its size.
+// Returns the file's first bytes (at most kMeshHeaderBytes) and its size.
 std::string readHeader(const std::filesystem::path& path, std::uint64_t& size);
 
 // The element counts a PLY header declares.
@@ -40,7 +40,7 @@ struct PlyElementCounts {
 };
 
 // A PLY header checked line by line before assimp sees it:
-//  - its structure: a "ply" line, a known format and end_header within the first kHeaderBytes.
+//  - its structure: a "ply" line, a known format and end_header within the first kMeshHeaderBytes.
 //    assimp 5.2's PLY reader loops without end, growing its memory, on a header that never ends
 //    (found by fuzzing).
 //  - its counts: assimp trusts them, reserving memory before it reads any element: a 200-byte PLY

@@ -62,7 +62,7 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
   bool bounded = false;
   const std::string ext = lowerExtension(path);
   if (!cached && (ext == ".obj" || ext == ".stl")) {
-    const RegularFile file = statRegularFile(path);
+    const ReadableFile file = statForReading(path);
     if (file.refusal == FileRefusal::None) {
       const double bound =
           kMeshBudgetBytesPerFileByte * static_cast<double>(file.size) + kMeshBudgetSlackBytes;

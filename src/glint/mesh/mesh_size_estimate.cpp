@@ -30,8 +30,8 @@ constexpr std::size_t kMaxScannedLine = 256;
 template <typename LineFn>
 void forEachLine(const std::filesystem::path& path, const std::atomic<bool>* cancel,
                  LineFn&& line) {
-  const RegularFile file = openMeshFile(path);
-  const int fd = file.handle.get();
+  const ReadableFile file = openMeshFile(path);
+  const int fd = file.fd;
   std::string carried;  // the start of a line that continues in the next read
   bool carrying = false;
   const auto keep = [&](const char* begin, std::size_t size) {
@@ -102,10 +102,10 @@ std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size,
   if (size > (std::uint64_t{64} << 20)) return total;  // a .gltf this big holds its own data
   std::string text;
   {
-    const RegularFile file = openMeshFile(path);
+    const ReadableFile file = openMeshFile(path);
     char buffer[1 << 16];
     for (;;) {
-      const ssize_t n = ::read(file.handle.get(), buffer, sizeof buffer);
+      const ssize_t n = ::read(file.fd, buffer, sizeof buffer);
       if (n < 0 && errno == EINTR) continue;
       if (n <= 0 || text.size() > size) break;
       text.append(buffer, static_cast<std::size_t>(n));
@@ -123,7 +123,7 @@ std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size,
     // A file outside the mesh's folder tree is not read (the load refuses it): not counted.
     const std::filesystem::path named = path.parent_path() / uri;
     if (!rule.refusal(named).empty()) continue;
-    const RegularFile file = statRegularFile(named);
+    const ReadableFile file = statForReading(named);
     if (file.refusal == FileRefusal::None) total += file.size;
   }
   return total;
