@@ -57,7 +57,7 @@ inline void writeFile(const std::filesystem::path& path, std::string_view bytes)
   require(static_cast<bool>(out));
 }
 
-// The promises of MeshFile (mesh_loader.h) for a file that loaded.
+// The promises of MeshFile (mesh_file.h) for a file that loaded.
 inline void checkMeshFile(const MeshFile& file) {
   require(!file.parts.empty());
   require(file.triangleCount() > 0 && file.triangleCount() <= kMaxMeshTriangles);

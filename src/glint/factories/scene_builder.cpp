@@ -296,8 +296,11 @@ class Builder {
     std::shared_ptr<const MeshFile> file;
     try {
       // Estimated (mesh + BVH, with the film) against the memory limit before anything is read.
-      file = meshCache_.load(path, MeshBudget{options_.imageMemoryBudget,
-                                              filmBytes(parts_.image.width, parts_.image.height)});
+      file = meshCache_.load(
+          path,
+          MeshBudget{options_.imageMemoryBudget,
+                     filmBytes(parts_.image.width, parts_.image.height)},
+          MeshReadOptions{.sceneFolder = baseDirectory(params), .cancel = options_.cancel});
     } catch (const MeshLoadError& e) {
       std::string reason = e.what();
       if (path != written && reason == "no such file") {
@@ -324,7 +327,8 @@ class Builder {
                                 shown, file->droppedTriangles,
                                 file->droppedTriangles == 1 ? "" : "s", triangles));
     }
-    std::vector<TriangleMesh> meshes = instantiateMesh(*file, worldFromFile, request.smooth);
+    std::vector<TriangleMesh> meshes =
+        instantiateMesh(*file, worldFromFile, request.smooth, options_.cancel);
     const std::vector<std::uint32_t>* scene = material.given ? nullptr : &fileMaterials(*file);
     for (TriangleMesh& mesh : meshes) {
       const MeshMaterial& own = file->materials[mesh.materialIndex];

@@ -136,27 +136,28 @@ class MeshBudgetTest : public ::testing::Test {
 };
 
 TEST_F(MeshBudgetTest, AMeshPastTheMemoryBudgetIsAnErrorAtItsObject) {
-  // The estimate: two copies of 12·1000 + 48·1002 bytes and 22 B per triangle of BVH = 142,192 B,
-  // plus the 4 × 3 film (288 B).
+  // The estimate: two copies of 12·1000 + 48·1002 bytes and 104 B per triangle of BVH build =
+  // 224,192 B, plus the 4 × 3 film (288 B).
   const std::uint64_t film = filmBytes(4, 3);
   ASSERT_EQ(film, 288u);
-  const std::vector<Diagnostic> errors = errorsWithBudget(142192 + film - 1);
+  const std::vector<Diagnostic> errors = errorsWithBudget(224192 + film - 1);
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_EQ(errors[0].where.line, 5);
   EXPECT_THAT(errors[0].message,
               HasSubstr("cannot load mesh file 'strip.obj': its estimated 1.0 thousand triangles "
-                        "need about 138.9 KiB as a mesh and its BVH"));
-  EXPECT_THAT(errors[0].message, HasSubstr("more than the memory limit of 139.1 KiB"));
-  const std::vector<Diagnostic> fits = errorsWithBudget(142192 + film);
+                        "need about 218.9 KiB as a mesh and its BVH"));
+  EXPECT_THAT(errors[0].message, HasSubstr("more than the memory limit of 219.2 KiB"));
+  const std::vector<Diagnostic> fits = errorsWithBudget(224192 + film);
   EXPECT_TRUE(fits.empty()) << fits[0].format();
 }
 
 TEST_F(MeshBudgetTest, EveryInstanceOfAFileCountsAgainstTheBudget) {
-  // A second instance adds one world copy and its BVH share (82,096 B): refused at its own line.
+  // A second instance adds one world copy and its BVH build share (164,096 B): refused at its own
+  // line.
   const std::uint64_t film = filmBytes(4, 3);
-  const std::vector<Diagnostic> fits = errorsWithBudget(142192 + 82096 + film, 2);
+  const std::vector<Diagnostic> fits = errorsWithBudget(224192 + 164096 + film, 2);
   EXPECT_TRUE(fits.empty()) << fits[0].format();
-  const std::vector<Diagnostic> errors = errorsWithBudget(142192 + 82096 + film - 1, 2);
+  const std::vector<Diagnostic> errors = errorsWithBudget(224192 + 164096 + film - 1, 2);
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_EQ(errors[0].where.line, 6);
   EXPECT_THAT(errors[0].message, HasSubstr("another instance of its 1.0 thousand triangles"));

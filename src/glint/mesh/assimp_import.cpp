@@ -1,0 +1,288 @@
+#include "glint/mesh/assimp_import.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <new>
+#include <set>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <assimp/BaseImporter.h>
+#include <assimp/DefaultIOSystem.h>
+#include <assimp/config.h>
+#include <assimp/importerdesc.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <fmt/format.h>
+#include <assimp/Importer.hpp>
+
+#include "glint/mesh/file_access.h"
+#include "glint/mesh/mesh_repair.h"
+#include "glint/scene/scene_limits.h"
+
+namespace glint {
+
+namespace {
+
+constexpr std::uint32_t kUnused = 0xffffffffu;
+
+// assimp's stream over a file glint opened itself (DefaultIOStream's constructor from a FILE* is
+// protected); closed when assimp deletes it.
+class OpenedFileStream : public Assimp::DefaultIOStream {
+ public:
+  OpenedFileStream(FILE* file, const std::string& name) : DefaultIOStream(file, name) {}
+};
+
+// assimp's file access for one mesh file and the files it names (MTL, glTF buffers): regular files
+// only (file_access.h: never opened when they are not, and checked again on what was opened),
+// read-only, and the named files only inside the folder tree of `rule`. A name such as /dev/zero
+// or a FIFO in a hostile file would otherwise be read without end or block forever, and one such
+// as ../../etc/passwd would be read from anywhere. A named file that breaks a rule refuses the
+// whole mesh file (refusal()), as DESIGN.md §9 asks of every file a mesh names; one that does not
+// exist is left to the importer (an OBJ without its MTL still loads).
+class MeshFileAccess : public Assimp::DefaultIOSystem {
+ public:
+  explicit MeshFileAccess(const ReferencedFileRule& rule) : rule_(rule) {}
+
+  using DefaultIOSystem::Exists;
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    if (file == nullptr || mode == nullptr ||
+        std::string_view(mode).find_first_of("wa+") != std::string_view::npos) {
+      return nullptr;
+    }
+    if (refused(rule_.refusal(file))) return nullptr;
+    ReadableFile opened = openForReading(file);
+    if (!accepted(file, opened) || refused(rule_.openedRefusal(opened.fd, file))) {
+      return nullptr;
+    }
+    FILE* stream = ::fdopen(opened.fd, "rb");
+    if (stream == nullptr) return nullptr;
+    opened.release();  // the stream closes it
+    return new OpenedFileStream(stream, file);
+  }
+  // DefaultIOSystem::Exists opens the file with fopen, which blocks on a FIFO.
+  bool Exists(const char* file) const override {
+    return file != nullptr && !refused(rule_.refusal(file)) && accepted(file, statForReading(file));
+  }
+
+  // Why a file the mesh file names refuses it ("" when none did), in the user's words.
+  const std::string& refusal() const { return refusal_; }
+
+ private:
+  // Keeps the first refusal; true when `why` is one.
+  bool refused(const std::string& why) const {
+    if (!why.empty() && refusal_.empty()) refusal_ = why;
+    return !why.empty();
+  }
+  bool accepted(const char* file, const ReadableFile& found) const {
+    if (found.refusal == FileRefusal::NotRegular) {
+      refused(rule_.isMeshFile(file)
+                  ? std::string("it is not a regular file")
+                  : fmt::format("it refers to '{}', which is not a regular file (a file a mesh "
+                                "names is never read from a FIFO or a device)",
+                                rule_.asWritten(file)));
+    }
+    return found.refusal == FileRefusal::None;
+  }
+
+  const ReferencedFileRule& rule_;  // outlives the importer (importMesh's caller holds it)
+  mutable std::string refusal_;     // set by the first refused file, from the const Exists too
+};
+
+// Leaves `importer` with only the importer(s) for `extension`: the glTF 2.0 one for .gltf/.glb
+// (not assimp's glTF 1.0 importer), the one importer of each other extension. assimp falls back to
+// trying every importer's signature test when the chosen one declines; with the others gone there
+// is nothing to fall back to.
+void keepOnlyImporterFor(Assimp::Importer& importer, const std::string& extension) {
+  const std::string bare = extension.substr(1);
+  std::vector<Assimp::BaseImporter*> unwanted;
+  for (std::size_t i = 0; i < importer.GetImporterCount(); ++i) {
+    Assimp::BaseImporter* candidate = importer.GetImporter(i);
+    if (candidate == nullptr) continue;
+    std::set<std::string> extensions;
+    candidate->GetExtensionList(extensions);
+    bool keep = extensions.count(bare) != 0;
+    if (keep && (bare == "gltf" || bare == "glb")) {
+      const aiImporterDesc* info = candidate->GetInfo();
+      keep = info != nullptr && std::string_view(info->mName).find("glTF2") != std::string::npos;
+    }
+    if (!keep) unwanted.push_back(candidate);
+  }
+  for (Assimp::BaseImporter* candidate : unwanted) {
+    // UnregisterLoader hands the importer back without deleting it.
+    if (importer.UnregisterLoader(candidate) == aiReturn_SUCCESS) delete candidate;
+  }
+}
+
+// assimp's message in the user's terms.
+std::string assimpReason(std::string_view message) {
+  if (message.find("No suitable reader found") != std::string_view::npos) {
+    return "the file's content does not match its extension, or it is damaged";
+  }
+  while (!message.empty() && (message.back() == '.' || message.back() == '\n')) {
+    message.remove_suffix(1);
+  }
+  if (message.empty()) return "the mesh library could not read it";
+  return "invalid file: " + std::string(message);
+}
+
+// A file's colour component made valid for glint: finite and ≥ 0.
+double component(float value) { return std::isfinite(value) && value > 0 ? value : 0.0; }
+Color colorOf(const aiColor3D& c) { return {component(c.r), component(c.g), component(c.b)}; }
+
+MeshMaterial convertMaterial(const aiMaterial& m) {
+  MeshMaterial out;
+  aiString name;
+  const bool named = m.Get(AI_MATKEY_NAME, name) == AI_SUCCESS;
+  if (named) out.name = name.C_Str();
+  aiColor4D base;
+  const bool hasBase = m.Get(AI_MATKEY_BASE_COLOR, base) == AI_SUCCESS;
+  // assimp's stand-in when the file has no material: named AI_DEFAULT_MATERIAL_NAME (STL, OBJ
+  // without MTL) or, from the PLY reader, without any name. glTF materials carry a base colour
+  // even when unnamed (and glTF's own default material is white by its specification).
+  if ((named && out.name == AI_DEFAULT_MATERIAL_NAME) || (!named && !hasBase)) {
+    out.material = kMeshDefaultMaterial;
+    out.fromFile = false;
+    return out;
+  }
+  Material& mat = out.material;
+  aiColor3D c;
+  if (m.Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS) {
+    mat.kd = colorOf(c);
+  } else if (hasBase) {
+    mat.kd = colorOf(aiColor3D(base.r, base.g, base.b));
+  }
+  mat.ka = mat.kd;
+  if (m.Get(AI_MATKEY_COLOR_SPECULAR, c) == AI_SUCCESS) {
+    mat.ks = colorOf(c);
+    float strength = 1;
+    if (m.Get(AI_MATKEY_SHININESS_STRENGTH, strength) == AI_SUCCESS) {
+      mat.ks = mat.ks * component(strength);
+    }
+  }
+  float value = 0;
+  if (m.Get(AI_MATKEY_SHININESS, value) == AI_SUCCESS) mat.shininess = component(value);
+  if (m.Get(AI_MATKEY_COLOR_EMISSIVE, c) == AI_SUCCESS) out.emission = colorOf(c);
+  if (m.Get(AI_MATKEY_OPACITY, value) == AI_SUCCESS && std::isfinite(value) && value < 1) {
+    mat.kt = Color(1 - std::max(0.0, static_cast<double>(value)));
+    if (m.Get(AI_MATKEY_REFRACTI, value) == AI_SUCCESS && std::isfinite(value) && value > 0) {
+      mat.ior = value;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+MeshFile importMesh(const std::filesystem::path& path, const std::string& extension,
+                    const ReferencedFileRule& rule) {
+  Assimp::Importer importer;
+  auto* files = new MeshFileAccess(rule);
+  importer.SetIOHandler(files);  // the importer owns it
+  keepOnlyImporterFor(importer, extension);
+  // Points and lines are not surfaces: SortByPType removes them after triangulation.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  importer.SetPropertyFloat(AI_CONFIG_PP_GSN_MAX_SMOOTHING_ANGLE,
+                            static_cast<float>(kMeshCreaseAngleDegrees));
+  // No JoinIdenticalVertices: joinMesh joins the vertices, faster and exactly.
+  unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
+                   aiProcess_GenSmoothNormals | aiProcess_SortByPType;
+  if (extension == ".stl") {
+    // STL stores one normal per facet, not per vertex: drop them so that GenSmoothNormals (which
+    // keeps normals a mesh already has) smooths the surface, and joinMesh can then share the
+    // vertices of neighbouring facets.
+    importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS);
+    flags |= aiProcess_RemoveComponent;
+  }
+
+  MeshFile result;
+  try {
+    // Read without post-processing first: the faces are checked before any step indexes with them.
+    const aiScene* scene = importer.ReadFile(path.string(), 0);
+    if (!files->refusal().empty()) throw MeshLoadError(files->refusal());
+    if (scene == nullptr) throw MeshLoadError(assimpReason(importer.GetErrorString()));
+    // The importer owns the scene and its steps edit it in place; so does dropInvalidFaces.
+    result.droppedTriangles = dropInvalidFaces(const_cast<aiScene&>(*scene));
+    splitSharedCorners(const_cast<aiScene&>(*scene));
+    if (scene->mRootNode == nullptr || facesWithTriangles(*scene) == 0) {
+      throw MeshLoadError(result.droppedTriangles > 0
+                              ? fmt::format("all {} triangles have vertex indices out of range",
+                                            result.droppedTriangles)
+                              : std::string("the file holds no triangles"));
+    }
+    scene = importer.ApplyPostProcessing(flags);
+    if (scene == nullptr) throw MeshLoadError(assimpReason(importer.GetErrorString()));
+
+    std::uint64_t triangles = 0;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) triangles += scene->mMeshes[m]->mNumFaces;
+    if (triangles > kMaxMeshTriangles) {
+      throw MeshLoadError(fmt::format("it holds {} triangles, more than the limit of {}",
+                                      formatCount(static_cast<double>(triangles)),
+                                      formatCount(static_cast<double>(kMaxMeshTriangles))));
+    }
+    std::size_t fileTriangles = result.droppedTriangles;
+    std::vector<JoinedMesh> joined(scene->mNumMeshes);
+    std::uint64_t vertices = 0;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+      const aiMesh& mesh = *scene->mMeshes[m];
+      if ((mesh.mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON)) == 0) {
+        continue;
+      }
+      fileTriangles += mesh.mNumFaces;
+      joined[m] = joinMesh(mesh, result.droppedTriangles);
+      vertices += joined[m].source.size();
+    }
+    // Refuse before copying: glint's arrays take 12 bytes per triangle and 48 per vertex.
+    const double bytes =
+        12.0 * static_cast<double>(triangles) + 48.0 * static_cast<double>(vertices);
+    const std::uint64_t physical = physicalMemoryBytes();
+    if (physical != 0 && bytes > static_cast<double>(physical) / 2) {
+      throw MeshLoadError(fmt::format("its {} triangles need {}, more than half the memory ({})",
+                                      formatCount(static_cast<double>(triangles)),
+                                      formatBytes(bytes),
+                                      formatBytes(static_cast<double>(physical))));
+    }
+
+    // Only the materials the triangles use, in order of first use.
+    std::vector<std::uint32_t> materialOf(scene->mNumMaterials, kUnused);
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+      const aiMesh& mesh = *scene->mMeshes[m];
+      if (joined[m].indices.empty()) continue;
+      TriangleMesh part = convertMesh(mesh, std::move(joined[m]));
+      if (part.indices.empty()) continue;
+      const unsigned source = mesh.mMaterialIndex;
+      if (source < scene->mNumMaterials && scene->mMaterials[source] != nullptr) {
+        if (materialOf[source] == kUnused) {
+          materialOf[source] = static_cast<std::uint32_t>(result.materials.size());
+          result.materials.push_back(convertMaterial(*scene->mMaterials[source]));
+        }
+        part.materialIndex = materialOf[source];
+      } else {
+        part.materialIndex = static_cast<std::uint32_t>(result.materials.size());
+        result.materials.push_back({"", kMeshDefaultMaterial, Color(), false});
+      }
+      result.parts.push_back(std::move(part));
+    }
+    if (result.parts.empty()) {
+      throw MeshLoadError(
+          fmt::format("all {} triangles are degenerate (zero area, non-finite or "
+                      "invalid vertices)",
+                      fileTriangles));
+    }
+  } catch (const std::bad_alloc&) {
+    throw MeshLoadError("not enough memory to load it");
+  } catch (const MeshLoadError&) {
+    throw;
+  } catch (const std::exception& e) {  // an importer's exception that escaped assimp
+    throw MeshLoadError(assimpReason(e.what()));
+  }
+  return result;
+}
+
+}  // namespace glint

@@ -1,0 +1,341 @@
+#include "glint/mesh/import_child.h"
+
+#include <fcntl.h>
+#include <malloc.h>
+#include <poll.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdint>
+#include <cstring>
+#include <ctime>
+#include <new>
+#include <optional>
+#include <string>
+#include <system_error>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "glint/core/cancel.h"
+#include "glint/mesh/assimp_import.h"
+#include "glint/mesh/file_access.h"
+
+namespace glint {
+
+namespace {
+
+// Fuzzing found memory corruption in assimp 5.2's importers (heap overflows in the glTF 2.0 and
+// PLY readers, a crash in OFF's) that no check before the import can rule out: the child process
+// runs assimp and sends the MeshFile back through a pipe; a crash or corruption there is a refused
+// file, never a crashed or corrupted renderer. The parent checks what it receives (sizes, indices,
+// materials) before using it.
+
+static_assert(std::is_trivially_copyable_v<Material> && std::is_trivially_copyable_v<Color> &&
+              std::is_trivially_copyable_v<Point3> && std::is_trivially_copyable_v<Normal3>);
+
+// Writes everything or stops silently (the parent sees a short message).
+bool writeAll(int fd, const void* data, std::size_t size) {
+  const char* p = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, p, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    p += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+template <typename T>
+bool writeValue(int fd, const T& value) {
+  return writeAll(fd, &value, sizeof value);
+}
+
+template <typename T>
+bool writeVector(int fd, const std::vector<T>& values) {
+  return writeValue(fd, std::uint64_t{values.size()}) &&
+         writeAll(fd, values.data(), values.size() * sizeof(T));
+}
+
+bool writeMessage(int fd, char tag, const std::string& text) {
+  return writeValue(fd, tag) && writeValue(fd, std::uint64_t{text.size()}) &&
+         writeAll(fd, text.data(), text.size());
+}
+
+bool writeMeshFile(int fd, const MeshFile& file) {
+  bool ok = writeValue(fd, 'M') && writeValue(fd, std::uint64_t{file.droppedTriangles}) &&
+            writeValue(fd, std::uint64_t{file.materials.size()});
+  for (const MeshMaterial& m : file.materials) {
+    ok = ok && writeMessage(fd, 'N', m.name) && writeValue(fd, m.material) &&
+         writeValue(fd, m.emission) && writeValue(fd, static_cast<char>(m.fromFile));
+  }
+  ok = ok && writeValue(fd, std::uint64_t{file.parts.size()});
+  for (const TriangleMesh& part : file.parts) {
+    ok = ok && writeValue(fd, part.materialIndex) && writeValue(fd, part.emission) &&
+         writeVector(fd, part.positions) && writeVector(fd, part.normals) &&
+         writeVector(fd, part.indices);
+  }
+  return ok;
+}
+
+// While waiting for the child, the parent looks at the cancel flag this often (milliseconds): a
+// cancelled load stops within about this time plus the kill of the child.
+constexpr int kCancelPollMilliseconds = 20;
+
+// The test hook's delay of the child (setImportChildDelayForTesting), in milliseconds.
+std::atomic<std::int64_t> gChildDelayMilliseconds{0};
+
+// Reads the child's answer, waiting at most until `deadline` for it: a reader that loops (as
+// assimp's importers have on malformed files) must not hang glint. While waiting and between
+// reads it polls `cancel` and throws Cancelled when it is set.
+class Reader {
+ public:
+  Reader(int fd, std::chrono::steady_clock::time_point deadline, const std::atomic<bool>* cancel)
+      : fd_(fd), cancel_(cancel), deadline_(deadline) {}
+  // Reads, from its start, a file the child has finished writing: nothing to wait for.
+  Reader(int file, const std::atomic<bool>* cancel) : fd_(file), file_(true), cancel_(cancel) {}
+  bool timedOut() const { return timedOut_; }
+  const std::atomic<bool>* cancel() const { return cancel_; }
+  void bytes(void* data, std::size_t size) {
+    char* p = static_cast<char*>(data);
+    while (file_ && size > 0) {
+      throwIfCancelled(cancel_);
+      const ssize_t n = ::pread(fd_, p, size, offset_);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) throw MeshLoadError("invalid file: the mesh reader stopped before its answer");
+      p += n;
+      offset_ += n;
+      size -= static_cast<std::size_t>(n);
+    }
+    while (size > 0) {
+      throwIfCancelled(cancel_);
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+          deadline_ - std::chrono::steady_clock::now());
+      if (left.count() <= 0) {
+        timedOut_ = true;
+        throw MeshLoadError("invalid file: the mesh library did not finish reading it within " +
+                            formatSeconds(deadline_ - started_));
+      }
+      pollfd ready{fd_, POLLIN, 0};
+      // Without a cancel flag there is nothing to look at until the deadline.
+      const std::int64_t wait = std::min<std::int64_t>(
+          left.count(), cancel_ != nullptr ? kCancelPollMilliseconds : std::int64_t{1} << 30);
+      const int polled = ::poll(&ready, 1, static_cast<int>(wait));
+      if ((polled < 0 && errno == EINTR) || polled == 0) continue;
+      const ssize_t n = ::read(fd_, p, size);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) throw MeshLoadError("invalid file: the mesh reader stopped before its answer");
+      p += n;
+      size -= static_cast<std::size_t>(n);
+    }
+  }
+  template <typename T>
+  T value() {
+    T v{};
+    bytes(&v, sizeof v);
+    return v;
+  }
+  std::uint64_t count(std::uint64_t limit) {
+    const auto n = value<std::uint64_t>();
+    if (n > limit) throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+    return n;
+  }
+  template <typename T>
+  void vector(std::vector<T>& out, std::uint64_t limit) {
+    out.resize(static_cast<std::size_t>(count(limit)));
+    bytes(out.data(), out.size() * sizeof(T));
+  }
+  std::string text() {
+    std::string t(static_cast<std::size_t>(count(1 << 20)), '\0');
+    bytes(t.data(), t.size());
+    return t;
+  }
+
+ private:
+  static std::string formatSeconds(std::chrono::steady_clock::duration d) {
+    return fmt::format("{:.0f} s", std::chrono::duration<double>(d).count());
+  }
+  int fd_;
+  bool file_ = false;
+  const std::atomic<bool>* cancel_;
+  off_t offset_ = 0;  // in a file
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point deadline_;
+  bool timedOut_ = false;
+};
+
+MeshFile receiveMeshFile(Reader& in) {
+  const char tag = in.value<char>();
+  if (tag == 'E') throw MeshLoadError(in.text());
+  if (tag != 'M') throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+  MeshFile file;
+  file.droppedTriangles = static_cast<std::size_t>(in.value<std::uint64_t>());
+  file.materials.resize(static_cast<std::size_t>(in.count(1 << 20)));
+  for (MeshMaterial& m : file.materials) {
+    if (in.value<char>() != 'N') {
+      throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+    }
+    m.name = in.text();
+    m.material = in.value<Material>();
+    m.emission = in.value<Color>();
+    m.fromFile = in.value<char>() != 0;
+  }
+  file.parts.resize(static_cast<std::size_t>(in.count(1 << 20)));
+  std::uint64_t triangles = 0;
+  for (TriangleMesh& part : file.parts) {
+    part.materialIndex = in.value<std::uint32_t>();
+    part.emission = in.value<Color>();
+    in.vector(part.positions, std::uint64_t{1} << 32);
+    in.vector(part.normals, part.positions.size());
+    in.vector(part.indices, 3 * kMaxMeshTriangles);
+    triangles += part.triangleCount();
+    bool ok = part.materialIndex < file.materials.size() && part.indices.size() % 3 == 0 &&
+              (part.normals.empty() || part.normals.size() == part.positions.size()) &&
+              triangles <= kMaxMeshTriangles;
+    // In blocks, polling the cancel flag between them: a mesh may hold hundreds of millions.
+    constexpr std::size_t kBlock = std::size_t{1} << 20;
+    for (std::size_t begin = 0; ok && begin < part.indices.size(); begin += kBlock) {
+      throwIfCancelled(in.cancel());
+      const std::size_t end = std::min(part.indices.size(), begin + kBlock);
+      for (std::size_t k = begin; k < end; ++k) ok = ok && part.indices[k] < part.positions.size();
+    }
+    if (!ok) throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+  }
+  return file;
+}
+
+// How long the child may take: kMeshReadBaseSeconds plus kMeshReadSecondsPerMiB per MiB of the
+// file — assimp reads a 85 MB OBJ in ~2.5 s here, so the limit only ends a reader that loops.
+std::chrono::steady_clock::duration meshReadTimeLimit(const std::filesystem::path& path) {
+  std::error_code error;
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  const double mib = error ? 0 : static_cast<double>(size) / (1024.0 * 1024.0);
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(kMeshReadBaseSeconds + kMeshReadSecondsPerMiB * mib));
+}
+
+}  // namespace
+
+void setImportChildDelayForTesting(std::chrono::milliseconds delay) {
+  gChildDelayMilliseconds.store(delay.count());
+}
+
+MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension,
+                           const ReferencedFileRule& rule, const std::atomic<bool>* cancel) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw MeshLoadError(systemReason(errno));
+  // The answer travels in a memory file when it can: the child writes it whole without waiting for
+  // a reader and says 'D' on the pipe; the parent then reads it in a few large reads. Through the
+  // pipe alone, 64 KiB at a time with the two processes taking turns, the 3.6 MB answer of a
+  // 100k-triangle mesh took 8-18 ms on a busy 2-core machine; through the memory file, 6-9 ms.
+  // When there is no memory file (memfd_create refused) or writing it fails (no memory, a file
+  // size limit), the child says 'P' and the answer follows on the pipe.
+  const int answer = ::memfd_create("glint-mesh-answer", MFD_CLOEXEC);
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    const int error = errno;
+    ::close(fds[0]);
+    ::close(fds[1]);
+    if (answer >= 0) ::close(answer);
+    throw MeshLoadError("cannot start the mesh reader: " + systemReason(error));
+  }
+  if (pid == 0) {
+    // The child: no destructor, atexit handler or stdio flush of the parent's state runs here.
+    // It dies with glint (killed or interrupted while loading), never left looping on its own.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(0);  // the parent was already gone
+    ::close(fds[0]);
+    // Large blocks from the heap rather than each from its own mmap: assimp's OBJ reader and the
+    // post-processing free buffers of megabytes (the file, a line buffer of the file's size, the
+    // meshes PreTransformVertices replaces) that later ones then reuse instead of faulting in
+    // fresh pages (~4 ms of a 100k-triangle OBJ). 32 MiB is the most glibc accepts. The child
+    // ends with _exit, so its heap is never given back in any case.
+    ::mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    ::signal(SIGXFSZ, SIG_IGN);  // a write past a file size limit fails instead
+    // Ctrl-C reaches the whole process group, the child too. Its fate is the parent's: a parent
+    // that handles the signal cancels the load and kills the child, one that dies of it takes the
+    // child along (PR_SET_PDEATHSIG); the child dying of it on its own would read as a crash.
+    for (const int stop : {SIGINT, SIGTERM, SIGHUP}) ::signal(stop, SIG_IGN);
+    if (const std::int64_t delay = gChildDelayMilliseconds.load(); delay > 0) {
+      const timespec pause{static_cast<time_t>(delay / 1000),
+                           static_cast<long>(delay % 1000) * 1000000};
+      ::nanosleep(&pause, nullptr);
+    }
+    MeshFile result;
+    std::string error;
+    try {
+      result = importMesh(path, extension, rule);
+    } catch (const MeshLoadError& e) {
+      error = e.what();
+    } catch (...) {
+      error = "invalid file: the mesh library failed reading it";
+    }
+    const auto send = [&](int fd) {
+      return error.empty() ? writeMeshFile(fd, result) : writeMessage(fd, 'E', error);
+    };
+    if (answer >= 0 && send(answer)) {
+      writeValue(fds[1], 'D');
+      ::_exit(0);
+    }
+    // A partly written memory file would hold its pages until the parent closes it, after the
+    // whole answer has come through the pipe as well: under the memory pressure that made the
+    // write fail, give them back first.
+    if (answer >= 0) static_cast<void>(::ftruncate(answer, 0));
+    if (writeValue(fds[1], 'P')) {
+      send(fds[1]);
+    }
+    ::_exit(0);
+  }
+  ::close(fds[1]);
+  std::optional<MeshFile> file;
+  std::string failure;
+  bool cancelled = false;
+  Reader in(fds[0], std::chrono::steady_clock::now() + meshReadTimeLimit(path), cancel);
+  try {
+    const char where = in.value<char>();
+    if (where == 'D' && answer >= 0) {
+      Reader written(answer, cancel);
+      file = receiveMeshFile(written);
+    } else if (where == 'P') {
+      file = receiveMeshFile(in);
+    } else {
+      throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+    }
+  } catch (const MeshLoadError& e) {
+    failure = e.what();
+  } catch (const std::bad_alloc&) {
+    failure = "not enough memory to load it";
+  } catch (const Cancelled&) {
+    cancelled = true;
+  }
+  ::close(fds[0]);  // a child still writing gets EPIPE and ends
+  if (answer >= 0) ::close(answer);
+  if (in.timedOut() || cancelled) ::kill(pid, SIGKILL);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (cancelled) throw Cancelled();
+  if (in.timedOut()) throw MeshLoadError(failure);
+  // SIGPIPE: the child was still writing when the parent stopped reading an inconsistent answer.
+  if (WIFSIGNALED(status) && WTERMSIG(status) != SIGPIPE) {
+    throw MeshLoadError(fmt::format(
+        "invalid file: the mesh library crashed reading it ({}; glint read it in a separate "
+        "process and is unaffected)",
+        strsignal(WTERMSIG(status))));
+  }
+  if (!file) throw MeshLoadError(failure);
+  return std::move(*file);
+}
+
+}  // namespace glint

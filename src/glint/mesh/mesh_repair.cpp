@@ -1,0 +1,311 @@
+#include "glint/mesh/mesh_repair.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+#include <assimp/mesh.h>
+#include <assimp/scene.h>
+
+#include "glint/mesh/mesh_file.h"
+
+namespace glint {
+
+namespace {
+
+// Twice a triangle's area may be at most this fraction of its longest edge squared before the
+// triangle counts as degenerate: Triangle::make's bound (geometry/shapes.cpp), so a mesh drops
+// exactly what a scene file would refuse as a `triangle`. Below it the normal (e1×e2)/|e1×e2| is
+// rounding noise, or NaN for coincident vertices.
+constexpr double kDegenerateTolerance = 1e-12;
+
+constexpr std::uint32_t kUnused = 0xffffffffu;
+
+// Triangles a face stands for: a polygon of n ≥ 3 corners fans into n − 2.
+std::size_t trianglesOf(const aiFace& face) {
+  return face.mNumIndices >= 3 ? face.mNumIndices - 2 : 1;
+}
+
+Vec3 faceNormal(const TriangleMesh& mesh, std::size_t triangle) {
+  const Point3& p0 = mesh.positions[mesh.indices[3 * triangle]];
+  const Point3& p1 = mesh.positions[mesh.indices[3 * triangle + 1]];
+  const Point3& p2 = mesh.positions[mesh.indices[3 * triangle + 2]];
+  return cross(p1 - p0, p2 - p0);  // length = twice the area
+}
+
+// Makes every vertex normal unit. A file's zero or non-finite normal is replaced by the
+// area-weighted mean of the normals of the triangles around the vertex.
+void repairNormals(TriangleMesh& mesh) {
+  if (mesh.normals.empty()) return;
+  std::vector<bool> invalid(mesh.normals.size(), false);
+  bool anyInvalid = false;
+  for (std::size_t v = 0; v < mesh.normals.size(); ++v) {
+    const Vec3 n = toVec(mesh.normals[v]);
+    const double len = length(n);
+    if (len > 0 && std::isfinite(len)) {
+      mesh.normals[v] = Normal3(n / len);
+    } else {
+      invalid[v] = true;
+      anyInvalid = true;
+    }
+  }
+  if (!anyInvalid) return;
+  std::vector<Vec3> sum(mesh.normals.size());
+  std::vector<Vec3> first(mesh.normals.size());
+  for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
+    const Vec3 n = faceNormal(mesh, t);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t v = mesh.indices[3 * t + k];
+      if (!invalid[v]) continue;
+      sum[v] += n;
+      if (first[v] == Vec3{}) first[v] = n;
+    }
+  }
+  for (std::size_t v = 0; v < mesh.normals.size(); ++v) {
+    if (!invalid[v]) continue;
+    // Opposite faces may cancel exactly; then one face's normal serves. Every vertex left belongs
+    // to a non-degenerate triangle, so `first` is non-zero.
+    mesh.normals[v] = Normal3(normalize(length(sum[v]) > 0 ? sum[v] : first[v]));
+  }
+}
+
+// The vertex data glint keeps, as a key for joining: position and normal in assimp's float. −0 is
+// made +0 (the two compare equal), and a normal that is not finite becomes 0 — every invalid normal
+// is one class, replaced by repairNormals from the triangles around the joined vertex.
+struct VertexKey {
+  float p[3];
+  float n[3];
+  bool operator==(const VertexKey& o) const {
+    return p[0] == o.p[0] && p[1] == o.p[1] && p[2] == o.p[2] && n[0] == o.n[0] && n[1] == o.n[1] &&
+           n[2] == o.n[2];
+  }
+};
+
+VertexKey keyOf(const aiMesh& mesh, unsigned v) {
+  VertexKey key{};
+  const aiVector3D& p = mesh.mVertices[v];
+  key.p[0] = p.x + 0.0f;
+  key.p[1] = p.y + 0.0f;
+  key.p[2] = p.z + 0.0f;
+  if (mesh.mNormals != nullptr) {
+    const aiVector3D& n = mesh.mNormals[v];
+    if (std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z)) {
+      key.n[0] = n.x + 0.0f;
+      key.n[1] = n.y + 0.0f;
+      key.n[2] = n.z + 0.0f;
+    }
+  }
+  return key;
+}
+
+std::uint64_t hashOf(const VertexKey& key) {
+  // FNV-1a over the six floats' bits (positions are finite here: triangles touching a non-finite
+  // vertex were dropped), then a 64-bit finaliser (splitmix64) to spread them over the table.
+  std::uint64_t h = 1469598103934665603ull;
+  for (const float* f : {key.p, key.n}) {
+    for (int i = 0; i < 3; ++i) {
+      std::uint32_t bits = 0;
+      std::memcpy(&bits, &f[i], sizeof bits);
+      h = (h ^ bits) * 1099511628211ull;
+    }
+  }
+  h ^= h >> 30;
+  h *= 0xbf58476d1ce4e5b9ull;
+  h ^= h >> 27;
+  h *= 0x94d049bb133111ebull;
+  return h ^ (h >> 31);
+}
+
+}  // namespace
+
+std::size_t dropInvalidFaces(aiScene& scene) {
+  std::size_t dropped = 0;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    aiMesh* mesh = scene.mMeshes[m];
+    if (mesh == nullptr || mesh->mFaces == nullptr) {
+      if (mesh != nullptr) mesh->mNumFaces = 0;
+      continue;
+    }
+    unsigned kept = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      aiFace& face = mesh->mFaces[f];
+      bool valid = face.mNumIndices > 0 && face.mIndices != nullptr && mesh->mVertices != nullptr;
+      for (unsigned i = 0; valid && i < face.mNumIndices; ++i) {
+        valid = face.mIndices[i] < mesh->mNumVertices;
+      }
+      if (!valid) {
+        dropped += trianglesOf(face);
+        continue;
+      }
+      if (kept != f) {
+        // Swap the members: aiFace's own copy assignment would copy the index arrays.
+        aiFace& to = mesh->mFaces[kept];
+        std::swap(to.mNumIndices, face.mNumIndices);
+        std::swap(to.mIndices, face.mIndices);
+      }
+      ++kept;
+    }
+    // The faces past `kept` stay allocated; delete[] mFaces still destroys all of them.
+    mesh->mNumFaces = kept;
+  }
+  return dropped;
+}
+
+void splitSharedCorners(aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    aiMesh* mesh = scene.mMeshes[m];
+    if (mesh == nullptr || mesh->mNormals != nullptr || mesh->mVertices == nullptr ||
+        mesh->mNumBones != 0 || mesh->mNumAnimMeshes != 0) {
+      continue;
+    }
+    std::uint64_t corners = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) corners += mesh->mFaces[f].mNumIndices;
+    if (corners == mesh->mNumVertices || corners > kMaxMeshTriangles * 3) continue;
+    auto* vertices = new aiVector3D[corners];
+    unsigned next = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      aiFace& face = mesh->mFaces[f];
+      for (unsigned i = 0; i < face.mNumIndices; ++i) {
+        vertices[next] = mesh->mVertices[face.mIndices[i]];  // checked by dropInvalidFaces
+        face.mIndices[i] = next++;
+      }
+    }
+    delete[] mesh->mVertices;
+    mesh->mVertices = vertices;
+    mesh->mNumVertices = next;
+    delete[] mesh->mTangents;
+    mesh->mTangents = nullptr;
+    delete[] mesh->mBitangents;
+    mesh->mBitangents = nullptr;
+    for (auto*& colors : mesh->mColors) {
+      delete[] colors;
+      colors = nullptr;
+    }
+    for (unsigned k = 0; k < AI_MAX_NUMBER_OF_TEXTURECOORDS; ++k) {
+      delete[] mesh->mTextureCoords[k];
+      mesh->mTextureCoords[k] = nullptr;
+      mesh->mNumUVComponents[k] = 0;
+    }
+  }
+}
+
+std::size_t facesWithTriangles(const aiScene& scene) {
+  std::size_t n = 0;
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* mesh = scene.mMeshes[m];
+    for (unsigned f = 0; mesh != nullptr && f < mesh->mNumFaces; ++f) {
+      if (mesh->mFaces[f].mNumIndices >= 3) ++n;
+    }
+  }
+  return n;
+}
+
+JoinedMesh joinMesh(const aiMesh& in, std::size_t& dropped) {
+  JoinedMesh out;
+  out.indices.reserve(std::size_t{3} * in.mNumFaces);
+  std::vector<VertexKey> keys;  // of the joined vertices, in step with out.source
+  std::vector<std::uint32_t> joinedOf(in.mNumVertices, kUnused);  // assimp vertex → joined
+  // Open addressing, linear probing, at most half full; sized for the joined vertices (a smooth
+  // OBJ surface has about one per six face corners) and doubled as they grow, so that the table
+  // stays small enough for the cache. A slot holds the joined vertex in its low 32 bits and the
+  // hash's high 32 bits above, which rule out almost every other key without reading it.
+  constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+  std::size_t slots = 16;
+  while (slots < std::size_t{in.mNumVertices} / 3) slots *= 2;
+  std::vector<std::uint64_t> table(slots, kEmpty);
+  const auto place = [&](std::uint64_t hash, std::uint32_t j) {
+    std::size_t slot = hash & (slots - 1);
+    while (table[slot] != kEmpty) slot = (slot + 1) & (slots - 1);
+    table[slot] = (hash & 0xffffffff00000000ull) | j;
+  };
+  // `key` and `hash` are those of assimp vertex v, not yet joined.
+  const auto join = [&](unsigned v, const VertexKey& key, std::uint64_t hash) {
+    const std::uint64_t tag = hash & 0xffffffff00000000ull;
+    for (std::size_t slot = hash & (slots - 1);; slot = (slot + 1) & (slots - 1)) {
+      const std::uint64_t entry = table[slot];
+      if (entry == kEmpty) break;
+      const auto j = static_cast<std::uint32_t>(entry);
+      if ((entry & 0xffffffff00000000ull) == tag && keys[j] == key) return joinedOf[v] = j;
+    }
+    const auto j = static_cast<std::uint32_t>(keys.size());
+    keys.push_back(key);
+    out.source.push_back(v);
+    if (2 * keys.size() > slots) {
+      slots *= 2;
+      table.assign(slots, kEmpty);
+      for (std::uint32_t k = 0; k < keys.size(); ++k) place(hashOf(keys[k]), k);
+    } else {
+      place(hash, j);
+    }
+    return joinedOf[v] = j;
+  };
+  for (unsigned f = 0; f < in.mNumFaces; ++f) {
+    const aiFace& face = in.mFaces[f];
+    if (face.mNumIndices != 3) {
+      if (face.mNumIndices > 3 || face.mNumIndices == 0) dropped += trianglesOf(face);
+      continue;
+    }
+    const unsigned a = face.mIndices[0];
+    const unsigned b = face.mIndices[1];
+    const unsigned c = face.mIndices[2];
+    if (a >= in.mNumVertices || b >= in.mNumVertices || c >= in.mNumVertices) {
+      ++dropped;
+      continue;
+    }
+    const auto point = [&](unsigned v) {
+      const aiVector3D& p = in.mVertices[v];
+      return Point3{p.x, p.y, p.z};
+    };
+    const Point3 p0 = point(a);
+    const Point3 p1 = point(b);
+    const Point3 p2 = point(c);
+    const double twiceArea = length(cross(p1 - p0, p2 - p0));
+    const double longest =
+        std::max({distanceSquared(p0, p1), distanceSquared(p1, p2), distanceSquared(p2, p0)});
+    // Also false for NaN and infinite coordinates, which make the area or the edges non-finite.
+    if (!(twiceArea > kDegenerateTolerance * longest) || !std::isfinite(twiceArea) ||
+        !std::isfinite(longest)) {
+      ++dropped;
+      continue;
+    }
+    // The three corners' keys and hashes first, their table slots fetched together: the lookups
+    // are cache misses more often than not, and three at once overlap.
+    const unsigned corners[3] = {a, b, c};
+    VertexKey cornerKeys[3] = {};
+    std::uint64_t hashes[3] = {};
+    for (int k = 0; k < 3; ++k) {
+      if (joinedOf[corners[k]] != kUnused) continue;
+      cornerKeys[k] = keyOf(in, corners[k]);
+      hashes[k] = hashOf(cornerKeys[k]);
+      __builtin_prefetch(&table[hashes[k] & (slots - 1)]);
+    }
+    for (int k = 0; k < 3; ++k) {
+      const unsigned v = corners[k];
+      out.indices.push_back(joinedOf[v] != kUnused ? joinedOf[v]
+                                                   : join(v, cornerKeys[k], hashes[k]));
+    }
+  }
+  return out;
+}
+
+TriangleMesh convertMesh(const aiMesh& in, JoinedMesh&& joined) {
+  TriangleMesh out;
+  out.indices = std::move(joined.indices);
+  out.positions.resize(joined.source.size());
+  for (std::size_t j = 0; j < joined.source.size(); ++j) {
+    const aiVector3D& p = in.mVertices[joined.source[j]];
+    out.positions[j] = {p.x, p.y, p.z};
+  }
+  if (in.HasNormals()) {
+    out.normals.resize(joined.source.size());
+    for (std::size_t j = 0; j < joined.source.size(); ++j) {
+      const aiVector3D& n = in.mNormals[joined.source[j]];
+      out.normals[j] = {n.x, n.y, n.z};
+    }
+  }
+  repairNormals(out);
+  return out;
+}
+
+}  // namespace glint

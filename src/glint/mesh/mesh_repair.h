@@ -1,0 +1,59 @@
+// Repairs of what assimp reads, before and after its post-processing, and the conversion into
+// glint's TriangleMesh: faces with invalid indices dropped, shared corners split so that generated
+// normals follow the crease angle, degenerate triangles dropped, vertices of equal position and
+// normal joined, invalid normals rebuilt. Internal to the mesh loader (run in its import child).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "glint/geometry/triangle_mesh.h"
+
+struct aiMesh;
+struct aiScene;
+
+namespace glint {
+
+// Removes, in place, every face that has no index or one past the mesh's vertices, before
+// assimp's post-processing steps (which index vertex arrays without checking) see it. Most
+// importers check their indices (OBJ refuses the file); PLY, for one, does not. Returns the
+// triangles removed. Faces of one or two indices (points, lines) stay for SortByPType to remove.
+std::size_t dropInvalidFaces(aiScene& scene);
+
+// Gives every face corner of a mesh without normals its own vertex, before GenSmoothNormals.
+// That step first stores each face's normal at its vertices — a vertex shared by several faces
+// keeps only the last one — and then averages the normals of the vertices at the same position
+// within the crease angle. Indexed files (PLY, glTF) share a vertex among all faces around it, so a
+// smooth surface got one face's normal per vertex (faceted, lopsided shading) and a crease could
+// not be kept. One vertex per corner, as assimp's OBJ and STL importers already give, lets every
+// corner average exactly the faces within the crease angle; glint's join (joinMesh) shares them
+// again afterwards. Texture coordinates and colours are dropped (glint reads neither); meshes
+// with bones are left alone (their weights index the vertices).
+void splitSharedCorners(aiScene& scene);
+
+// Faces of at least three corners in all meshes of the scene.
+std::size_t facesWithTriangles(const aiScene& scene);
+
+// One assimp mesh's triangles with the degenerate ones left out, over joined vertices: the
+// vertices of equal position and normal (VertexKey) are one, numbered in order of first use by
+// the kept triangles. assimp's importers give OBJ and STL one vertex per face corner; glint joins
+// them here, exactly and in O(n) with a hash table, instead of assimp's JoinIdenticalVertices
+// (which compares within an epsilon through a spatial sort, and also compares texture
+// coordinates glint does not use: ~0.1 s of a 0.3 s load for a 100k-triangle OBJ).
+// GenSmoothNormals has already run (assimp runs it before any join), so the normals of a crease
+// differ and its vertices stay split.
+struct JoinedMesh {
+  std::vector<std::uint32_t> indices;  // three per kept triangle, into `source`
+  std::vector<std::uint32_t> source;   // the assimp vertex each joined vertex copies
+};
+
+// Adds the triangles left out to `dropped`.
+JoinedMesh joinMesh(const aiMesh& in, std::size_t& dropped);
+
+// One assimp mesh (triangulated, its node transforms baked), joined, → a TriangleMesh in file
+// space. Invalid vertex normals (zero or not finite) are rebuilt from the triangles around the
+// vertex.
+TriangleMesh convertMesh(const aiMesh& in, JoinedMesh&& joined);
+
+}  // namespace glint

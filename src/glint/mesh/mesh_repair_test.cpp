@@ -1,0 +1,286 @@
+// What glint repairs in a mesh file (DESIGN.md §5 `mesh`, §7): normals generated with the crease
+// angle (also for indexed files), corners joined into shared vertices exactly, creases and seams
+// kept, degenerate and invalid triangles dropped and counted, invalid file normals rebuilt.
+#include "glint/mesh/mesh_repair.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "glint/mesh/mesh_file.h"
+#include "glint/mesh/mesh_test_support.h"
+
+namespace glint::mesh_test {
+namespace {
+
+TEST(MeshRepair, GeneratedNormalsKeepEdgesSharperThanTheCreaseAngle) {
+  // cube.ply: six quads without normals. Its 90° edges exceed the 80° crease angle, so every
+  // generated normal is the normal of its face: ± an axis.
+  const fs::path ply = kModels / "PLY/cube.ply";
+  ASSERT_TRUE(installed(ply));
+  const MeshFile file = readMeshFile(ply);
+  expectWellFormed(file);
+  EXPECT_EQ(file.triangleCount(), 12u);  // 6 faces of 4 corners in the file
+  expectBounds(boundsOf(file.parts), {{0, 0, 0}, {1, 1, 1}}, 0);
+  // And each corner carries the normal of its own face, not that of another face around the
+  // shared vertex of the file: 8 positions, three normals each.
+  for (const TriangleMesh& part : file.parts) {
+    EXPECT_EQ(part.positions.size(), 24u);
+    for (std::size_t t = 0; t < part.triangleCount(); ++t) {
+      const std::uint32_t* i = &part.indices[3 * t];
+      const Vec3 face = normalize(cross(part.positions[i[1]] - part.positions[i[0]],
+                                        part.positions[i[2]] - part.positions[i[0]]));
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(dot(face, part.normals[i[k]]), 1, 1e-6);
+    }
+  }
+}
+
+// The OBJ text of a regular icosahedron with vertices (0, ±1, ±φ) and their cyclic permutations
+// (edge 2), faces outward, and no normals.
+std::string icosahedronObj() {
+  const double phi = (1 + std::sqrt(5.0)) / 2;
+  std::vector<Point3> v;
+  for (double a : {-1.0, 1.0}) {
+    for (double b : {-phi, phi}) {
+      v.push_back({0, a, b});
+      v.push_back({a, b, 0});
+      v.push_back({b, 0, a});
+    }
+  }
+  std::ostringstream obj;
+  obj.precision(17);
+  for (const Point3& p : v) obj << "v " << p.x << " " << p.y << " " << p.z << "\n";
+  const auto edge = [&](std::size_t i, std::size_t j) {
+    return std::abs(distance(v[i], v[j]) - 2) < 1e-9;
+  };
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    for (std::size_t j = i + 1; j < v.size(); ++j) {
+      for (std::size_t k = j + 1; k < v.size(); ++k) {
+        if (!edge(i, j) || !edge(j, k) || !edge(k, i)) continue;
+        const bool outward = dot(cross(v[j] - v[i], v[k] - v[i]), toVec(v[i])) > 0;
+        obj << "f " << i + 1 << " " << (outward ? j : k) + 1 << " " << (outward ? k : j) + 1
+            << "\n";
+      }
+    }
+  }
+  return obj.str();
+}
+
+// The icosahedron of icosahedronObj as loaded with generated smooth normals: 20 triangles over 12
+// shared vertices, each with the direction of the vertex itself as its normal (by symmetry, the
+// average of the five faces around it).
+void expectIcosahedronWithVertexNormals(const MeshFile& file) {
+  expectWellFormed(file);
+  ASSERT_EQ(file.parts.size(), 1u);
+  const TriangleMesh& part = file.parts[0];
+  EXPECT_EQ(part.triangleCount(), 20u);
+  ASSERT_EQ(part.positions.size(), 12u);  // shared: one normal per vertex
+  for (std::size_t v = 0; v < part.positions.size(); ++v) {
+    const Vec3 expected = normalize(toVec(part.positions[v]));
+    EXPECT_NEAR(part.normals[v].x, expected.x, 1e-6) << "vertex " << v;
+    EXPECT_NEAR(part.normals[v].y, expected.y, 1e-6) << "vertex " << v;
+    EXPECT_NEAR(part.normals[v].z, expected.z, 1e-6) << "vertex " << v;
+  }
+}
+
+TEST(MeshRepair, GeneratedNormalsAreSmoothBelowTheCreaseAngle) {
+  // A regular icosahedron without normals. Around a vertex, the five face normals are at most
+  // 70.5° apart (< 80°), so every corner's normal averages all five, which by symmetry gives the
+  // direction of the vertex itself, and the corners of one vertex share one normal.
+  TempDir dir;
+  const std::string text = icosahedronObj();
+  ASSERT_EQ(std::count(text.begin(), text.end(), 'f'), 20);
+  expectIcosahedronWithVertexNormals(readMeshFile(dir.write("icosahedron.obj", text)));
+}
+
+// The vertex lines (coordinates as written) and 0-based faces of icosahedronObj, for writing the
+// same solid in other formats.
+struct IcosahedronText {
+  std::vector<std::string> vertices;
+  std::vector<std::array<std::size_t, 3>> faces;
+};
+IcosahedronText icosahedronText() {
+  IcosahedronText out;
+  std::istringstream obj(icosahedronObj());
+  std::string line;
+  while (std::getline(obj, line)) {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (keyword == "v") out.vertices.push_back(line.substr(2));
+    if (keyword != "f") continue;
+    std::array<std::size_t, 3> face{};
+    for (std::size_t& index : face) {
+      words >> index;
+      --index;
+    }
+    out.faces.push_back(face);
+  }
+  return out;
+}
+
+// The icosahedron of icosahedronObj as an indexed ASCII PLY without normals: 12 shared vertices.
+std::string icosahedronPly() {
+  const IcosahedronText ico = icosahedronText();
+  std::ostringstream ply;
+  ply << "ply\nformat ascii 1.0\nelement vertex " << ico.vertices.size()
+      << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << ico.faces.size()
+      << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const std::string& v : ico.vertices) ply << v << "\n";
+  for (const auto& f : ico.faces) ply << "3 " << f[0] << " " << f[1] << " " << f[2] << "\n";
+  return ply.str();
+}
+
+TEST(MeshRepair, IndexedFilesWithoutNormalsGetSmoothNormalsPerVertex) {
+  // The same icosahedron, but indexed (PLY shares each vertex among its five faces): the generated
+  // normal of a vertex must still average all five faces (the vertex direction), not keep the
+  // normal of whichever face came last.
+  TempDir dir;
+  expectIcosahedronWithVertexNormals(readMeshFile(dir.write("icosahedron.ply", icosahedronPly())));
+}
+
+// ------------------------------------------------------------------------------ joined vertices
+
+// The icosahedron of icosahedronObj as ASCII STL: 20 facets of three vertices each, stored apart
+// (STL has no shared vertices), with facet normals glint discards.
+std::string icosahedronStl() {
+  const IcosahedronText ico = icosahedronText();
+  std::ostringstream stl;
+  stl << "solid ico\n";
+  for (const auto& face : ico.faces) {
+    stl << "facet normal 0 0 0\nouter loop\n";
+    for (const std::size_t index : face) stl << "vertex " << ico.vertices.at(index) << "\n";
+    stl << "endloop\nendfacet\n";
+  }
+  stl << "endsolid ico\n";
+  return stl.str();
+}
+
+TEST(MeshRepair, DeindexedStlCornersAreJoinedIntoSharedVertices) {
+  // 60 corners in the file at 12 distinct positions, every corner's generated normal the smooth
+  // one (the icosahedron's dihedral angles are below the crease angle): 12 shared vertices, the
+  // same as the indexed OBJ of the same solid.
+  TempDir dir;
+  const MeshFile stl = readMeshFile(dir.write("icosahedron.stl", icosahedronStl()));
+  expectWellFormed(stl);
+  ASSERT_EQ(stl.parts.size(), 1u);
+  EXPECT_EQ(stl.parts[0].triangleCount(), 20u);
+  EXPECT_EQ(stl.parts[0].positions.size(), 12u);
+  EXPECT_EQ(stl.droppedTriangles, 0u);
+  const MeshFile obj = readMeshFile(dir.write("icosahedron.obj", icosahedronObj()));
+  ASSERT_EQ(obj.parts.size(), 1u);
+  // The same vertices in the same order (first use by the triangles, which are in the same order).
+  ASSERT_EQ(obj.parts[0].positions.size(), 12u);
+  for (std::size_t v = 0; v < 12; ++v) {
+    EXPECT_NEAR(distance(stl.parts[0].positions[v], obj.parts[0].positions[v]), 0, 1e-6);
+    EXPECT_NEAR(length(toVec(stl.parts[0].normals[v]) - toVec(obj.parts[0].normals[v])), 0, 1e-6);
+  }
+  EXPECT_EQ(stl.parts[0].indices, obj.parts[0].indices);
+}
+
+TEST(MeshRepair, CreasesKeepOneVertexPerNormal) {
+  // A unit cube of 8 positions and 6 quads, without normals. Every 90° edge is a crease (beyond
+  // the 80° crease angle), so each position carries three generated normals, one per face around
+  // it: 24 vertices, each with its face's normal.
+  TempDir dir;
+  const MeshFile file = readMeshFile(
+      dir.write("cube.obj",
+                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"));
+  expectWellFormed(file);
+  ASSERT_EQ(file.parts.size(), 1u);
+  const TriangleMesh& part = file.parts[0];
+  EXPECT_EQ(part.triangleCount(), 12u);
+  EXPECT_EQ(part.positions.size(), 24u);
+  std::map<std::tuple<double, double, double>, int> normalsAt;
+  for (const Point3& p : part.positions) ++normalsAt[{p.x, p.y, p.z}];
+  EXPECT_EQ(normalsAt.size(), 8u);
+  for (const auto& [position, normals] : normalsAt) EXPECT_EQ(normals, 3);
+  for (std::size_t t = 0; t < part.triangleCount(); ++t) {
+    const std::uint32_t* i = &part.indices[3 * t];
+    const Vec3 face = normalize(cross(part.positions[i[1]] - part.positions[i[0]],
+                                      part.positions[i[2]] - part.positions[i[0]]));
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(dot(face, part.normals[i[k]]), 1, 1e-6);
+  }
+}
+
+TEST(MeshRepair, SeamsOfSplitNormalsKeepBothNormals) {
+  // Two triangles hinged on the edge of vertices 2 and 3. In `seam` each triangle gives the
+  // shared edge its own normal (`vn`): the edge's two positions carry two normals each, so 6
+  // vertices. In `smooth` both use one normal: 4 vertices. Corners that differ only in a texture
+  // coordinate (glint does not use them) or in the sign of a zero coordinate are one vertex.
+  TempDir dir;
+  const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 1\nvt 0 0\nvt 1 1\n";
+  const MeshFile seam = readMeshFile(
+      dir.write("seam.obj", v + "vn 0 0 1\nvn 0 1 0\nf 1//1 2//1 3//1\nf 2//2 4//2 3//2\n"));
+  ASSERT_EQ(seam.parts.size(), 1u);
+  EXPECT_EQ(seam.parts[0].positions.size(), 6u);
+  const std::vector<std::uint32_t> seamIndices{0, 1, 2, 3, 4, 5};
+  EXPECT_EQ(seam.parts[0].indices, seamIndices);
+  EXPECT_EQ(seam.parts[0].normals[1], Normal3(0, 0, 1));
+  EXPECT_EQ(seam.parts[0].normals[3], Normal3(0, 1, 0));
+  EXPECT_EQ(seam.parts[0].positions[1], seam.parts[0].positions[3]);
+
+  const MeshFile smooth = readMeshFile(
+      dir.write("smooth.obj", v + "v -0 0 -0\nvn 0 0 1\nf 5/1/1 2/1/1 3/1/1\nf 2/2/1 4/2/1 3/1/1\n"
+                                  "f 1/2/1 3/1/1 2/2/1\n"));
+  ASSERT_EQ(smooth.parts.size(), 1u);
+  EXPECT_EQ(smooth.parts[0].positions.size(), 4u);
+  const std::vector<std::uint32_t> smoothIndices{0, 1, 2, 1, 3, 2, 0, 2, 1};
+  EXPECT_EQ(smooth.parts[0].indices, smoothIndices);
+}
+
+// ------------------------------------------------------------------- degenerate and invalid faces
+
+TEST(MeshRepair, DegenerateTrianglesAreDroppedAndCounted) {
+  TempDir dir;
+  // Two good triangles, one collinear (zero area), one with a repeated vertex.
+  const fs::path obj = dir.write("degenerate.obj",
+                                 "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv 1 1 0\n"
+                                 "f 1 2 3\nf 2 5 3\nf 1 2 4\nf 1 1 3\n");
+  const MeshFile file = readMeshFile(obj);
+  expectWellFormed(file);
+  EXPECT_EQ(file.droppedTriangles, 2u);
+  EXPECT_EQ(file.triangleCount(), 2u);
+  // Vertex 4 (2, 0, 0) was used only by the dropped triangle: it is gone from the arrays too.
+  EXPECT_EQ(file.parts[0].positions.size(), 4u);
+  expectBounds(boundsOf(file.parts), {{0, 0, 0}, {1, 1, 0}}, 0);
+}
+
+TEST(MeshRepair, FacesWithIndicesOutOfRangeAreDroppedAndCounted) {
+  // PLY, unlike OBJ, does not check its indices itself.
+  TempDir dir;
+  const fs::path ply = dir.write("bad_index.ply",
+                                 "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\n"
+                                 "property float y\nproperty float z\nelement face 3\n"
+                                 "property list uchar int vertex_indices\nend_header\n"
+                                 "0 0 0\n1 0 0\n0 1 0\n1 1 0\n"
+                                 "3 0 1 2\n3 1 3 2\n4 0 1 7 2\n");
+  const MeshFile file = readMeshFile(ply);
+  expectWellFormed(file);
+  EXPECT_EQ(file.triangleCount(), 2u);
+  EXPECT_EQ(file.droppedTriangles, 2u);  // the quad with index 7 stood for two triangles
+}
+
+TEST(MeshRepair, InvalidFileNormalsAreRepairedFromTheFaces) {
+  // A zero normal in the file (vn 0 0 0) is replaced by the mean of the faces around the vertex.
+  TempDir dir;
+  const fs::path obj = dir.write("zero_normal.obj",
+                                 "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 0\n"
+                                 "f 1//1 2//2 3//1\n");
+  const MeshFile file = readMeshFile(obj);
+  expectWellFormed(file);
+  ASSERT_EQ(file.triangleCount(), 1u);
+  for (const Normal3& n : file.parts[0].normals) EXPECT_EQ(n, Normal3(0, 0, 1));
+}
+
+}  // namespace
+}  // namespace glint::mesh_test
