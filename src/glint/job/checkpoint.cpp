@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "glint/core/atomic_file.h"
+#include "glint/core/file_access.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/scene_limits.h"
 
@@ -97,15 +98,6 @@ void copyTile(const PixelRegion& tile, const Film& from, Film& to) {
 }
 
 // Closes a POSIX file descriptor when it goes out of scope.
-struct FileDescriptor {
-  explicit FileDescriptor(int descriptor) : fd(descriptor) {}
-  int fd = -1;
-  FileDescriptor(const FileDescriptor&) = delete;
-  FileDescriptor& operator=(const FileDescriptor&) = delete;
-  ~FileDescriptor() {
-    if (fd >= 0) ::close(fd);
-  }
-};
 
 // Whether `bytes` starts with the magic and this glint's format version.
 bool hasMagicAndVersion(std::string_view bytes) {
@@ -381,10 +373,16 @@ std::string openFailure(int error) {
   return std::generic_category().message(error);
 }
 
-CheckpointError notRegular(const fs::path& path, const struct stat& info) {
-  return cannotRead(path, S_ISDIR(info.st_mode)
-                              ? "it is a folder"
-                              : "it is not a regular file (a device, FIFO or socket)");
+// Why the checkpoint at `path` cannot be read (core/file_access.h), in this file's words.
+CheckpointError refused(const fs::path& path, const ReadableFile& file) {
+  switch (file.refusal) {
+    case FileRefusal::Folder:
+      return cannotRead(path, "it is a folder");
+    case FileRefusal::NotRegular:
+      return cannotRead(path, "it is not a regular file (a device, FIFO or socket)");
+    default:
+      return cannotRead(path, openFailure(file.error));
+  }
 }
 
 }  // namespace
@@ -392,22 +390,16 @@ CheckpointError notRegular(const fs::path& path, const struct stat& info) {
 void checkCheckpointFile(const fs::path& path) {
   // stat, not open: reading a device such as /dev/zero would never end, and opening a FIFO would
   // wait for a writer forever.
-  struct stat info {};
-  if (::stat(path.c_str(), &info) != 0) throw cannotRead(path, openFailure(errno));
-  if (!S_ISREG(info.st_mode)) throw notRegular(path, info);
+  const ReadableFile file = statForReading(path);
+  if (file.refusal != FileRefusal::None) throw refused(path, file);
 }
 
 Checkpoint readCheckpoint(const fs::path& path, std::uint64_t memoryBudget) {
-  checkCheckpointFile(path);
-  // O_NONBLOCK: should the name have become a FIFO since the stat, the open does not wait; fstat
-  // then sees what was really opened.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-  if (fd < 0) throw cannotRead(path, openFailure(errno));
-  const FileDescriptor closer{fd};
-  struct stat info {};
-  if (::fstat(fd, &info) != 0) throw cannotRead(path, openFailure(errno));
-  if (!S_ISREG(info.st_mode)) throw notRegular(path, info);
-  const auto size = static_cast<std::uint64_t>(info.st_size);
+  // Opened only when regular, checked again on what was opened (a FIFO swapped in meanwhile).
+  const ReadableFile file = openForReading(path);
+  if (file.refusal != FileRefusal::None) throw refused(path, file);
+  const int fd = file.fd;
+  const std::uint64_t size = file.size;
 
   // Reads up to `count` more bytes into `bytes` (fewer at the end of the file).
   std::string bytes;

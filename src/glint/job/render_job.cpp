@@ -12,6 +12,7 @@
 
 #include "glint/core/atomic_file.h"
 #include "glint/core/cancel.h"
+#include "glint/core/file_access.h"
 #include "glint/image/image_writer.h"
 #include "glint/job/checkpoint.h"
 #include "glint/job/job_steps.h"
@@ -39,16 +40,13 @@ std::string readSceneAgain(const fs::path& file) {
                     fmt::format("cannot read '{}' again to fingerprint it", file.string()));
   };
   constexpr std::uint64_t kMaxSceneBytes = std::uint64_t{256} << 20;
-  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-  if (fd < 0) throw failure();
+  const ReadableFile opened = openForReading(file);
+  bool ok = opened.refusal == FileRefusal::None && opened.size <= kMaxSceneBytes;
   std::string bytes;
-  struct stat info {};
-  bool ok = ::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) &&
-            static_cast<std::uint64_t>(info.st_size) <= kMaxSceneBytes;
-  if (ok) bytes.reserve(static_cast<std::size_t>(info.st_size));
+  if (ok) bytes.reserve(static_cast<std::size_t>(opened.size));
   char buffer[1 << 16];
   while (ok && bytes.size() <= kMaxSceneBytes) {
-    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    const ssize_t n = ::read(opened.fd, buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       ok = n == 0;
@@ -56,7 +54,6 @@ std::string readSceneAgain(const fs::path& file) {
     }
     bytes.append(buffer, static_cast<std::size_t>(n));
   }
-  ::close(fd);
   if (!ok || bytes.size() > kMaxSceneBytes) throw failure();
   return bytes;
 }

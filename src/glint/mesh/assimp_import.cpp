@@ -21,7 +21,7 @@
 #include <fmt/format.h>
 #include <assimp/Importer.hpp>
 
-#include "glint/mesh/file_access.h"
+#include "glint/core/file_access.h"
 #include "glint/mesh/mesh_repair.h"
 #include "glint/scene/scene_limits.h"
 

@@ -13,7 +13,7 @@
 
 #include <fmt/format.h>
 
-#include "glint/mesh/file_access.h"
+#include "glint/core/file_access.h"
 #include "glint/mesh/mesh_file.h"
 #include "glint/scene/scene_limits.h"
 

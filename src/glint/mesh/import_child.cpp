@@ -28,7 +28,7 @@
 
 #include "glint/core/cancel.h"
 #include "glint/mesh/assimp_import.h"
-#include "glint/mesh/file_access.h"
+#include "glint/core/file_access.h"
 
 namespace glint {
 

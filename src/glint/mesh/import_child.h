@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <string>
 
-#include "glint/mesh/file_access.h"
+#include "glint/core/file_access.h"
 #include "glint/mesh/mesh_file.h"
 
 namespace glint {

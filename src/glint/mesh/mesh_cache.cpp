@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "glint/core/cancel.h"
-#include "glint/mesh/file_access.h"
+#include "glint/core/file_access.h"
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/mesh_size_estimate.h"
 #include "glint/scene/scene_limits.h"

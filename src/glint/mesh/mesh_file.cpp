@@ -5,7 +5,7 @@
 #include <utility>
 
 #include "glint/core/cancel.h"
-#include "glint/mesh/file_access.h"
+#include "glint/core/file_access.h"
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/import_child.h"
 
@@ -79,6 +79,28 @@ std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
     out.push_back(std::move(mesh));
   }
   return out;
+}
+
+std::string meshFileRefusal(const ReadableFile& file) {
+  switch (file.refusal) {
+    case FileRefusal::None:
+      return "";
+    case FileRefusal::Missing:
+      return "no such file";
+    case FileRefusal::Folder:
+      return "it is a folder, not a mesh file";
+    case FileRefusal::NotRegular:
+      return "it is not a regular file";
+    case FileRefusal::System:
+      break;
+  }
+  return systemReason(file.error);
+}
+
+ReadableFile openMeshFile(const std::filesystem::path& path) {
+  ReadableFile file = openForReading(path);
+  if (file.refusal != FileRefusal::None) throw MeshLoadError(meshFileRefusal(file));
+  return file;
 }
 
 }  // namespace glint

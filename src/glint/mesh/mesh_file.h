@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "glint/core/color.h"
+#include "glint/core/file_access.h"
 #include "glint/core/transform.h"
 #include "glint/geometry/triangle_mesh.h"
 #include "glint/scene/material.h"
@@ -123,5 +124,12 @@ MeshFile readMeshFile(const std::filesystem::path& path, const MeshReadOptions& 
 std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
                                           const std::optional<Transform>& worldFromFile,
                                           bool smooth, const std::atomic<bool>* cancel = nullptr);
+
+// The reason a mesh file is refused, in the user's words: "no such file", "it is a folder, not a
+// mesh file", "it is not a regular file", or the system's reason.
+std::string meshFileRefusal(const ReadableFile& file);
+
+// openForReading for a mesh file itself: a refusal throws MeshLoadError (meshFileRefusal).
+ReadableFile openMeshFile(const std::filesystem::path& path);
 
 }  // namespace glint

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "glint/core/cancel.h"
-#include "glint/mesh/file_access.h"
+#include "glint/core/file_access.h"
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/mesh_file.h"
 

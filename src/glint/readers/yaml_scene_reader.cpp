@@ -194,13 +194,13 @@ ParseResult readSceneFile(const std::filesystem::path& path, const std::string& 
                         "the file is larger than 256 MiB; a scene file holds a scene description "
                         "(meshes belong in their own files)"}});
   };
-  OpenedFile opened = openRegularFile(path, name);
+  const ReadableFile opened = openRegularFile(path, name);
   if (opened.size > kMaxSceneFileBytes) throw tooLarge();
   std::filesystem::path base = path.parent_path();
   if (base.empty()) base = ".";
   SceneDescription scene = emptyScene(name, base);
   try {
-    yaml::Document document = yaml::readFile(opened.handle.get(), kMaxSceneFileBytes, {}, cancel);
+    yaml::Document document = yaml::readFile(opened.fd, kMaxSceneFileBytes, {}, cancel);
     return describe(std::move(scene), &document, nullptr);
   } catch (const yaml::SyntaxError& e) {
     // A file that grew past the limit while it was read.

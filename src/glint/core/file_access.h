@@ -1,9 +1,9 @@
-// How the mesh loader opens files (DESIGN.md §7): regular files only, and the files a mesh file
-// names only inside the folder tree it may use. A FIFO would block the reader forever and a device
-// such as /dev/zero never ends, so a path is stat'ed first (a FIFO or device is refused without
-// being opened), then opened with O_NONBLOCK (a FIFO put in its place meanwhile opens without
-// waiting for a writer) and checked again with fstat on what was opened. Internal to the mesh
-// loader.
+// How glint opens the files it reads (DESIGN.md §7): regular files only, and the files a file
+// names (a mesh's MTL and buffers, later textures) only inside the folder tree it may use. A FIFO
+// would block the reader forever and a device such as /dev/zero never ends, so a path is stat'ed
+// first (a FIFO or device is refused without being opened), then opened with O_NONBLOCK (a FIFO put
+// in its place meanwhile opens without waiting for a writer) and checked again with fstat on what
+// was opened.
 #pragma once
 
 #include <cstdint>
@@ -32,7 +32,8 @@ struct ReadableFile {
   int fd = -1;  // open for reading (blocking, close-on-exec) when opened and refusal is None
   std::uint64_t size = 0;  // bytes
   FileRefusal refusal = FileRefusal::None;
-  int error = 0;  // errno for Missing and System
+  int error = 0;      // errno for Missing and System
+  unsigned mode = 0;  // st_mode, when stat or fstat answered
 
   ReadableFile() = default;
   ReadableFile(ReadableFile&& other) noexcept;
@@ -51,12 +52,8 @@ ReadableFile statForReading(const std::filesystem::path& path);
 // is cleared before returning).
 ReadableFile openForReading(const std::filesystem::path& path);
 
-// The reason a mesh file is refused, in the user's words: "no such file", "it is a folder, not a
-// mesh file", "it is not a regular file", or the system's reason.
-std::string meshFileRefusal(const ReadableFile& file);
-
-// openForReading for a mesh file itself: a refusal throws MeshLoadError (meshFileRefusal).
-ReadableFile openMeshFile(const std::filesystem::path& path);
+// What a file that is not regular is, for messages: "a FIFO", "a device", "a socket".
+std::string nonRegularKind(unsigned mode);
 
 // The folder tree that the files a mesh file names (MTL libraries, glTF buffers and images, and
 // texture files) must lie in: the scene file's folder when the mesh file lies in it, else (and
@@ -67,8 +64,9 @@ ReadableFile openMeshFile(const std::filesystem::path& path);
 // mesh file itself is exempt: the scene names it.
 class ReferencedFileRule {
  public:
+  // `what` names the naming file in messages: "mesh file", "texture".
   ReferencedFileRule(const std::filesystem::path& meshFile,
-                     const std::filesystem::path& sceneFolder);
+                     const std::filesystem::path& sceneFolder, std::string_view what = "mesh file");
 
   // Why the file at `path` may not be read, or "" when it may. `path` is the name as the importer
   // formed it (the mesh file's folder joined with the reference); the message names the reference

@@ -1,4 +1,4 @@
-#include "glint/mesh/file_access.h"
+#include "glint/core/file_access.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -11,8 +11,6 @@
 
 #include <fmt/format.h>
 
-#include "glint/mesh/mesh_file.h"
-
 namespace glint {
 
 std::string systemReason(int error) {
@@ -22,7 +20,11 @@ std::string systemReason(int error) {
 }
 
 ReadableFile::ReadableFile(ReadableFile&& other) noexcept
-    : fd(other.release()), size(other.size), refusal(other.refusal), error(other.error) {}
+    : fd(other.release()),
+      size(other.size),
+      refusal(other.refusal),
+      error(other.error),
+      mode(other.mode) {}
 
 ReadableFile& ReadableFile::operator=(ReadableFile&& other) noexcept {
   if (this != &other) {
@@ -31,6 +33,7 @@ ReadableFile& ReadableFile::operator=(ReadableFile&& other) noexcept {
     size = other.size;
     refusal = other.refusal;
     error = other.error;
+    mode = other.mode;
   }
   return *this;
 }
@@ -57,11 +60,19 @@ ReadableFile failed(int error) {
 
 }  // namespace
 
+std::string nonRegularKind(unsigned mode) {
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
+  return "not a regular file";
+}
+
 ReadableFile statForReading(const std::filesystem::path& path) {
   struct stat info {};
   if (::stat(path.c_str(), &info) != 0) return failed(errno);
   ReadableFile file;
   file.refusal = refusalOf(info);
+  file.mode = info.st_mode;
   file.size = static_cast<std::uint64_t>(info.st_size);
   return file;
 }
@@ -74,6 +85,7 @@ ReadableFile openForReading(const std::filesystem::path& path) {
   struct stat info {};
   if (::fstat(file.fd, &info) != 0) return failed(errno);
   file.refusal = refusalOf(info);
+  file.mode = info.st_mode;
   if (file.refusal != FileRefusal::None) {
     ::close(file.release());
     return file;
@@ -81,28 +93,6 @@ ReadableFile openForReading(const std::filesystem::path& path) {
   const int flags = ::fcntl(file.fd, F_GETFL);
   if (flags < 0 || ::fcntl(file.fd, F_SETFL, flags & ~O_NONBLOCK) != 0) return failed(errno);
   file.size = static_cast<std::uint64_t>(info.st_size);
-  return file;
-}
-
-std::string meshFileRefusal(const ReadableFile& file) {
-  switch (file.refusal) {
-    case FileRefusal::None:
-      return "";
-    case FileRefusal::Missing:
-      return "no such file";
-    case FileRefusal::Folder:
-      return "it is a folder, not a mesh file";
-    case FileRefusal::NotRegular:
-      return "it is not a regular file";
-    case FileRefusal::System:
-      break;
-  }
-  return systemReason(file.error);
-}
-
-ReadableFile openMeshFile(const std::filesystem::path& path) {
-  ReadableFile file = openForReading(path);
-  if (file.refusal != FileRefusal::None) throw MeshLoadError(meshFileRefusal(file));
   return file;
 }
 
@@ -138,21 +128,22 @@ fs::path folderOf(fs::path folder) {
 
 }  // namespace
 
-ReferencedFileRule::ReferencedFileRule(const fs::path& meshFile, const fs::path& sceneFolder)
+ReferencedFileRule::ReferencedFileRule(const fs::path& meshFile, const fs::path& sceneFolder,
+                                       std::string_view what)
     : meshFile_(meshFile.string()), meshFolder_(meshFile.parent_path().string()) {
   const fs::path meshLexical = lexicalPath(meshFile);
   if (!sceneFolder.empty()) {
     const fs::path scene = folderOf(sceneFolder);
     if (within(meshLexical, scene) && within(resolvedPath(meshFile), resolvedPath(scene))) {
       lexicalRoot_ = scene;
-      why_ = "a mesh file may only name files in its scene file's folder and below";
+      why_ = fmt::format("a {} may only name files in its scene file's folder and below", what);
     } else {
-      why_ =
-          "a mesh file outside the scene file's folder may only name files in its own folder "
-          "and below";
+      why_ = fmt::format(
+          "a {} outside the scene file's folder may only name files in its own folder and below",
+          what);
     }
   } else {
-    why_ = "a mesh file may only name files in its own folder and below";
+    why_ = fmt::format("a {} may only name files in its own folder and below", what);
   }
   if (lexicalRoot_.empty()) lexicalRoot_ = meshLexical.parent_path();
   resolvedRoot_ = resolvedPath(lexicalRoot_);

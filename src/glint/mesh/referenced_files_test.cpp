@@ -1,7 +1,7 @@
 // The folder tree the files a mesh file names must lie in (DESIGN.md §7): glTF buffers and OBJ
 // material libraries outside the scene file's folder — by "..", by an absolute name, or through a
 // symbolic link — refuse the mesh file, naming the reference; inside it they are read.
-#include "glint/mesh/file_access.h"
+#include "glint/core/file_access.h"
 
 #include <fmt/format.h>
 #include <gmock/gmock.h>
