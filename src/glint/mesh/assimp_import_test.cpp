@@ -18,7 +18,6 @@
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/mesh_file.h"
 #include "glint/mesh/mesh_test_support.h"
-#include "glint/readers/yaml_tree.h"
 
 namespace glint::mesh_test {
 namespace {
@@ -290,7 +289,7 @@ TEST(MeshImport, AsciiStlCountAndBoundsFromTheText) {
 
 // The JSON chunk of a .glb (12-byte header, then the chunk's uint32 length and type, then JSON),
 // read with glint's own YAML reader (JSON is YAML).
-yaml::Stream glbJson(const fs::path& path, std::string& storage) {
+GltfJson glbJson(const fs::path& path, std::string& storage) {
   const std::string bytes = readText(path);
   std::uint32_t length = 0;
   std::memcpy(&length, bytes.data() + 12, 4);
@@ -298,22 +297,22 @@ yaml::Stream glbJson(const fs::path& path, std::string& storage) {
   return parseGltfJson(storage);
 }
 
-double number(const yaml::Node& node) { return std::stod(node.scalar()); }
-std::size_t count(const yaml::Node& node) { return std::stoul(node.scalar()); }
+double number(const ValueView& node) { return std::stod(std::string(node.scalar())); }
+std::size_t count(const ValueView& node) { return std::stoul(std::string(node.scalar())); }
 
 TEST(MeshImport, GlbBoxTrianglesAndBoundsThroughItsNodeMatrix) {
   const fs::path glb = kModels / "glTF2/BoxTextured-glTF-Binary/BoxTextured.glb";
   ASSERT_TRUE(installed(glb));
   std::string json;
-  const yaml::Stream doc = glbJson(glb, json);
-  const yaml::Node& root = doc.root;
+  const GltfJson doc = glbJson(glb, json);
+  const ValueView root = doc.root();
   // One mesh of one primitive under node 1, the child of node 0 which has a (column-major) matrix.
-  const yaml::Node primitive = root.find("meshes")[0].find("primitives")[0];
-  const yaml::Node accessors = root.find("accessors");
+  const ValueView primitive = root.find("meshes")[0].find("primitives")[0];
+  const ValueView accessors = root.find("accessors");
   const std::size_t triangles =
       count(accessors[count(primitive.find("indices"))].find("count")) / 3;
-  const yaml::Node position = accessors[count(primitive.find("attributes").find("POSITION"))];
-  const yaml::Node matrix = root.find("nodes")[0].find("matrix");
+  const ValueView position = accessors[count(primitive.find("attributes").find("POSITION"))];
+  const ValueView matrix = root.find("nodes")[0].find("matrix");
   ASSERT_EQ(matrix.size(), 16u);
   Bounds3 expected;
   for (int corner = 0; corner < 8; ++corner) {
@@ -346,26 +345,26 @@ TEST(MeshImport, GlbNodeHierarchyIsBakedEveryMeshInstanceCounted) {
   const fs::path glb = kModels / "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
   ASSERT_TRUE(installed(glb));
   std::string json;
-  const yaml::Stream doc = glbJson(glb, json);
-  const yaml::Node& root = doc.root;
-  const yaml::Node nodes = root.find("nodes");
-  const yaml::Node meshes = root.find("meshes");
-  const yaml::Node accessors = root.find("accessors");
+  const GltfJson doc = glbJson(glb, json);
+  const ValueView root = doc.root();
+  const ValueView nodes = root.find("nodes");
+  const ValueView meshes = root.find("meshes");
+  const ValueView accessors = root.find("accessors");
   std::size_t triangles = 0;
   const std::function<void(std::size_t)> walk = [&](std::size_t n) {
-    const yaml::Node node = nodes[n];
+    const ValueView node = nodes[n];
     if (node.find("mesh").isDefined()) {
-      const yaml::Node primitives = meshes[count(node.find("mesh"))].find("primitives");
+      const ValueView primitives = meshes[count(node.find("mesh"))].find("primitives");
       for (std::size_t p = 0; p < primitives.size(); ++p) {
-        const yaml::Node mode = primitives[p].find("mode");
+        const ValueView mode = primitives[p].find("mode");
         ASSERT_TRUE(!mode.isDefined() || count(mode) == 4);  // triangles
         triangles += count(accessors[count(primitives[p].find("indices"))].find("count")) / 3;
       }
     }
-    const yaml::Node children = node.find("children");
+    const ValueView children = node.find("children");
     for (std::size_t c = 0; c < children.size(); ++c) walk(count(children[c]));
   };
-  const yaml::Node sceneNodes = root.find("scenes")[count(root.find("scene"))].find("nodes");
+  const ValueView sceneNodes = root.find("scenes")[count(root.find("scene"))].find("nodes");
   for (std::size_t i = 0; i < sceneNodes.size(); ++i) walk(count(sceneNodes[i]));
   ASSERT_EQ(triangles, 121496u);
 

@@ -166,9 +166,9 @@ PlyElementCounts checkPlyHeader(const std::string& header, std::uint64_t size) {
                           static_cast<std::uint64_t>(vertexCount)};
 }
 
-yaml::Stream parseGltfJson(const std::string& text) {
+GltfJson parseGltfJson(const std::string& text) {
   try {
-    return yaml::parse(text);
+    return GltfJson{yaml::read(text)};
   } catch (const yaml::SyntaxError& e) {
     throw MeshLoadError(fmt::format("invalid file: its JSON cannot be read ({})", e.what()));
   }
@@ -177,18 +177,18 @@ yaml::Stream parseGltfJson(const std::string& text) {
 namespace {
 
 // The count of accessor `index` of a glTF document, or 0 when there is none.
-std::uint64_t accessorCount(const yaml::Node& accessors, const yaml::Node& index) {
+std::uint64_t accessorCount(const ValueView& accessors, const ValueView& index) {
   if (!index.isScalar()) return 0;
   std::size_t i = 0;
   try {
-    i = std::stoul(index.scalar());
+    i = std::stoul(std::string(index.scalar()));
   } catch (const std::exception&) {
     return 0;
   }
-  const yaml::Node count = accessors[i].find("count");
+  const ValueView count = accessors[i].find("count");
   if (!count.isScalar()) return 0;
   try {
-    return std::stoull(count.scalar());
+    return std::stoull(std::string(count.scalar()));
   } catch (const std::exception&) {
     return 0;
   }
@@ -224,17 +224,17 @@ void checkGltfPrimitives(const std::filesystem::path& path, const std::string& e
     }
     text.resize(filled);
   }
-  const yaml::Stream json = parseGltfJson(text);
-  const yaml::Node accessors = json.root.find("accessors");
-  const yaml::Node meshes = json.root.find("meshes");
+  const GltfJson json = parseGltfJson(text);
+  const ValueView accessors = json.root().find("accessors");
+  const ValueView meshes = json.root().find("meshes");
   for (std::size_t m = 0; m < meshes.size(); ++m) {
-    const yaml::Node primitives = meshes[m].find("primitives");
+    const ValueView primitives = meshes[m].find("primitives");
     for (std::size_t p = 0; p < primitives.size(); ++p) {
-      const yaml::Node primitive = primitives[p];
-      const std::string mode = primitive.find("mode").scalar();
+      const ValueView primitive = primitives[p];
+      const std::string_view mode = primitive.find("mode").scalar();
       const std::uint64_t minimum = mode == "3" ? 2 : (mode == "5" || mode == "6") ? 3 : 0;
       if (minimum == 0) continue;
-      const yaml::Node indices = primitive.find("indices");
+      const ValueView indices = primitive.find("indices");
       const std::uint64_t count =
           indices.isDefined()
               ? accessorCount(accessors, indices)

@@ -7,7 +7,8 @@
 #include <filesystem>
 #include <string>
 
-#include "glint/readers/yaml_tree.h"
+#include "glint/readers/value_tree.h"
+#include "glint/readers/yaml_reader.h"
 
 namespace glint {
 
@@ -58,6 +59,10 @@ void checkGltfPrimitives(const std::filesystem::path& path, const std::string& e
 
 // A glTF file's JSON as a tree. glint's YAML reader is the JSON parser (JSON is YAML); this is the
 // mesh loader's only call of it. Throws MeshLoadError when the text is not valid JSON.
-yaml::Stream parseGltfJson(const std::string& text);
+struct GltfJson {
+  yaml::Document document;
+  ValueView root() const { return {&document.values, document.root}; }
+};
+GltfJson parseGltfJson(const std::string& text);
 
 }  // namespace glint

@@ -109,4 +109,35 @@ class ValueTree {
   ValueId root_ = kNoValue;
 };
 
+// A value of a tree as a handle with lookups, for code that reads a known structure (a glTF
+// file's JSON): a missing key or an item past the end is a view of no value, whose lookups give
+// no value again, so a chain of lookups needs no checks in between.
+class ValueView {
+ public:
+  ValueView() = default;
+  ValueView(const ValueTree* tree, ValueId id) : tree_(tree), id_(tree ? id : kNoValue) {}
+  bool isDefined() const { return id_ != kNoValue; }
+  bool isScalar() const { return isDefined() && tree_->isScalar(id_); }
+  bool isList() const { return isDefined() && tree_->isList(id_); }
+  bool isMap() const { return isDefined() && tree_->isMap(id_); }
+  std::string_view scalar() const { return isDefined() ? tree_->scalar(id_) : std::string_view(); }
+  std::size_t size() const { return isDefined() ? tree_->size(id_) : 0; }
+  // Item i of a list.
+  ValueView operator[](std::size_t i) const {
+    return isList() && i < size() ? ValueView(tree_, tree_->item(id_, i)) : ValueView();
+  }
+  // The value of the first entry of a mapping whose key is `key`.
+  ValueView find(std::string_view key) const {
+    for (std::size_t i = 0; isMap() && i < size(); ++i) {
+      if (tree_->scalar(tree_->key(id_, i)) == key) return {tree_, tree_->value(id_, i)};
+    }
+    return {};
+  }
+  ValueId id() const { return id_; }
+
+ private:
+  const ValueTree* tree_ = nullptr;
+  ValueId id_ = kNoValue;
+};
+
 }  // namespace glint
