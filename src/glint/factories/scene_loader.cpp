@@ -36,7 +36,7 @@ LoadedScene build(ParseResult parsed, const LoadOptions& options) {
   std::stable_sort(warnings.begin(), warnings.end(), before);
   if (!errors.empty()) throw SceneError(std::move(errors));
   const SourceFile& scene = *parsed.description.files.at(0);
-  return LoadedScene{std::move(built.parts), std::move(warnings), scene.bytes, scene.fnv1a};
+  return LoadedScene{std::move(built.parts), std::move(warnings), scene.bytes};
 }
 
 }  // namespace

@@ -141,7 +141,6 @@ ParseResult describe(SceneDescription scene, yaml::Document* document,
     sink.error(at(failure->where()), failure->what());
   } else {
     file.values = std::move(document->values);
-    file.fnv1a = document->fnv1a;
     file.bytes = document->bytesRead;
     if (document->secondDocument) {
       sink.error(at(*document->secondDocument),
