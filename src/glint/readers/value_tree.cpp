@@ -122,6 +122,18 @@ void ValueTree::close() {
   pending_.resize(frame.firstPending);
 }
 
+std::vector<ValueId> ValueTree::openChildren() const {
+  assert(!frames_.empty());
+  return {pending_.begin() + static_cast<std::ptrdiff_t>(frames_.back().firstPending),
+          pending_.end()};
+}
+
+void ValueTree::replaceOpenChildren(const std::vector<ValueId>& children) {
+  assert(!frames_.empty());
+  pending_.resize(frames_.back().firstPending);
+  pending_.insert(pending_.end(), children.begin(), children.end());
+}
+
 void ValueTree::attach(ValueId id) {
   if (frames_.empty()) {
     if (root_ == kNoValue) root_ = id;

@@ -71,6 +71,10 @@ class ValueTree {
   // The first value added outside any collection (the document's root), or kNoValue.
   ValueId root() const { return root_; }
   std::size_t openCollections() const { return frames_.size(); }
+  // The children added so far to the innermost open collection (a mapping's: key, value, ...), and
+  // their replacement before it is closed (a reader resolving YAML merge keys).
+  std::vector<ValueId> openChildren() const;
+  void replaceOpenChildren(const std::vector<ValueId>& children);
 
   // Short identifier-like scalars (keys, type names, material names: a letter or '_' first) are
   // stored once per text in a small cache; numbers and longer text each time.

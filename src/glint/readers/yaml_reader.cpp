@@ -434,6 +434,10 @@ class Reader {
                             (value.empty() || value == "~" || value == "null" || value == "Null" ||
                              value == "NULL");
         countValue(e.start_mark);
+        // A plain `<<` as a key is YAML's merge key: resolved when its mapping closes.
+        if (e.data.scalar.style == YAML_PLAIN_SCALAR_STYLE && value == "<<" && atKey()) {
+          mergeIn_.back() = true;
+        }
         const ValueId id = isNull ? doc_.values.addNull(positionOf(e.start_mark))
                                   : doc_.values.addScalar(value, positionOf(e.start_mark));
         added(id, e.data.scalar.anchor);
@@ -487,10 +491,66 @@ class Reader {
     added(id, anchor);
     open_[id] = true;
     stack_.push_back(id);
+    mergeIn_.push_back(false);
+  }
+
+  // Whether the next value is a key of the innermost open mapping.
+  bool atKey() const {
+    return !stack_.empty() && doc_.values.kind(stack_.back()) == ValueKind::Map &&
+           doc_.values.openChildren().size() % 2 == 0;
+  }
+
+  // YAML's merge keys (`<<: *base`, `<<: [*a, *b]`) in the innermost mapping: the entries of the
+  // mappings named join it, unless it has the key itself or an earlier merged mapping had it;
+  // they keep the places where they were written.
+  void resolveMergeKeys() {
+    const ValueTree& t = doc_.values;
+    const std::vector<ValueId> children = t.openChildren();
+    std::vector<ValueId> own, merged;
+    std::vector<std::string_view> present;
+    const auto isMergeKey = [&](ValueId key) { return t.isScalar(key) && t.scalar(key) == "<<"; };
+    for (std::size_t i = 0; i + 1 < children.size(); i += 2) {
+      if (isMergeKey(children[i])) continue;
+      own.push_back(children[i]);
+      own.push_back(children[i + 1]);
+      if (t.isScalar(children[i])) present.push_back(t.scalar(children[i]));
+    }
+    const auto mergeFrom = [&](ValueId map, ValueId where) {
+      if (!t.isMap(map)) {
+        throw SyntaxError(t.position(where),
+                          "a merge key '<<' takes a mapping or a list of mappings (an alias "
+                          "*name of one)",
+                          SyntaxError::Kind::Syntax);
+      }
+      for (std::size_t i = 0; i < t.size(map); ++i) {
+        const ValueId key = t.key(map, i);
+        if (isMergeKey(key)) continue;  // already resolved when that mapping closed
+        const std::string_view name = t.scalar(key);
+        if (t.isScalar(key) && std::find(present.begin(), present.end(), name) != present.end()) {
+          continue;
+        }
+        merged.push_back(key);
+        merged.push_back(t.value(map, i));
+        if (t.isScalar(key)) present.push_back(name);
+      }
+    };
+    for (std::size_t i = 0; i + 1 < children.size(); i += 2) {
+      if (!isMergeKey(children[i])) continue;
+      const ValueId value = children[i + 1];
+      if (t.isList(value)) {
+        for (std::size_t j = 0; j < t.size(value); ++j) mergeFrom(t.item(value, j), value);
+      } else {
+        mergeFrom(value, t.isNull(value) ? children[i] : value);
+      }
+    }
+    own.insert(own.end(), merged.begin(), merged.end());
+    doc_.values.replaceOpenChildren(own);
   }
 
   // A closed collection's weight: itself plus its children's (aliased subtrees included).
   void close() {
+    if (mergeIn_.back()) resolveMergeKeys();
+    mergeIn_.pop_back();
     const ValueId id = stack_.back();
     stack_.pop_back();
     doc_.values.close();
@@ -593,6 +653,7 @@ class Reader {
   Document doc_;
   int documents_ = 0;
   std::vector<ValueId> stack_;
+  std::vector<bool> mergeIn_;  // per open collection: it has a merge key `<<`
   std::unordered_map<std::string, ValueId> anchors_;
   // Per value: values of its subtree with aliases expanded (saturating), and whether it is open.
   std::vector<std::uint64_t> weight_;

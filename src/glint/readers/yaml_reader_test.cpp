@@ -193,6 +193,36 @@ TEST(YamlReader, Utf16AndUtf8WithAByteOrderMarkAreRead) {
   EXPECT_EQ(d8.values.scalar(find(d8, "a")), "\xc3\xa9");
 }
 
+TEST(YamlReader, MergeKeysJoinTheNamedMappingsWithoutOverridingOwnKeys) {
+  const Document d = read(
+      "base: &base {a: 1, b: 2}\n"
+      "more: &more {b: 20, c: 30}\n"
+      "one: {<<: *base, b: 5}\n"
+      "two: &two {<<: [*more, *base], d: 4}\n"
+      "three: {<<: *two}\n");
+  const ValueTree& t = d.values;
+  const auto entries = [&](std::string_view key) {
+    std::string out;
+    const ValueId map = find(d, key);
+    for (std::size_t i = 0; i < t.size(map); ++i) {
+      out +=
+          std::string(t.scalar(t.key(map, i))) + "=" + std::string(t.scalar(t.value(map, i))) + " ";
+    }
+    return out;
+  };
+  EXPECT_EQ(entries("one"), "b=5 a=1 ");              // own b wins
+  EXPECT_EQ(entries("two"), "d=4 b=20 c=30 a=1 ");    // the first merged mapping wins
+  EXPECT_EQ(entries("three"), "d=4 b=20 c=30 a=1 ");  // merged through a merged mapping
+  // Merged entries keep their own places (the anchor's lines).
+  EXPECT_EQ(t.position(t.key(find(d, "one"), 1)).line, 1u);
+  // A quoted "<<" is an ordinary key.
+  const Document quoted = read("a: {\"<<\": 1}\n");
+  EXPECT_EQ(quoted.values.scalar(quoted.values.key(find(quoted, "a"), 0)), "<<");
+  const SyntaxError bad = errorOf("a: {<<: 3}\n");
+  EXPECT_EQ(bad.kind(), SyntaxError::Kind::Syntax);
+  EXPECT_NE(std::string(bad.what()).find("merge key"), std::string::npos);
+}
+
 class YamlFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
