@@ -222,6 +222,10 @@ const std::vector<BrokenScene> kBrokenScenes{
     {"adaptive_max_below_samples.yaml", "10:28", {"max_samples", "image.samples"}},
     {"adaptive_threshold_zero.yaml", "9:43", {"threshold"}},
     {"aperture_without_focus.yaml", "6:13", {"focus_distance", "look_at"}},
+    {"undefined_texture.yaml", "12:67", {"undefined texture 'tyles'", "did you mean 'tiles'"}},
+    {"unknown_texture_type.yaml", "10:18", {"chequer", "checker2d"}},
+    {"missing_texture_file.yaml", "10:88", {"nowhere.png", "no such file"}},
+    {"unknown_background_type.yaml", "9:21", {"skybox", "gradient or image"}},
 };
 
 TEST_F(Cli, BrokenScenesExitTwoNamingFileLineAndColumn) {

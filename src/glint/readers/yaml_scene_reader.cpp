@@ -41,8 +41,8 @@ class TopLevel {
 
   void read(ValueId root) {
     ParameterDictionary top(reader_, root, {"at the top level", "", "the scene"});
-    top.declare({"name", "background", "ambient", "camera", "image", "render", "materials",
-                 "objects", "lights"});
+    top.declare({"name", "background", "ambient", "camera", "image", "render", "textures",
+                 "materials", "objects", "lights"});
     for (const char* key : {"camera", "image"}) {
       if (!top.has(key)) {
         sink_.error(startOf(source_), fmt::format("the scene is missing required key '{}'", key));
@@ -54,7 +54,8 @@ class TopLevel {
     section(top, "camera", EntityKind::CameraEntity);
     section(top, "image", EntityKind::ImageEntity);
     section(top, "render", EntityKind::RenderEntity);
-    materials(top);
+    named(top, "textures", "texture", EntityKind::TextureEntity);
+    named(top, "materials", "material", EntityKind::MaterialEntity);
     list(top, "objects", "objects", EntityKind::ObjectEntity);
     list(top, "lights", "lights", EntityKind::LightEntity);
     top.finish();
@@ -82,25 +83,24 @@ class TopLevel {
     if (const auto e = top.find(key)) add(kind, 0, e->value, e->key);
   }
 
-  // `materials`: a mapping from names to materials, each an entity named by its key.
-  void materials(ParameterDictionary& top) {
-    const auto e = top.find("materials");
+  // `materials`, `textures`: a mapping from names to entities, each named by its key.
+  void named(ParameterDictionary& top, std::string_view section, std::string_view what,
+             EntityKind kind) {
+    const auto e = top.find(section);
     if (!e || tree().isNull(e->value)) return;  // `materials:` with nothing under it: none
     if (!tree().isMap(e->value)) {
-      top.error(e->where, fmt::format("materials: expected a mapping from material names to "
-                                      "materials, got {}",
-                                      reader_.describe(e->value)));
+      top.error(e->where, fmt::format("{}: expected a mapping from {} names to {}s, got {}",
+                                      section, what, what, reader_.describe(e->value)));
       return;
     }
     for (std::size_t i = 0; i < tree().size(e->value); ++i) {
       const ValueId key = tree().key(e->value, i);
       if (!tree().isScalar(key)) {
         reader_.error(
-            key, fmt::format("expected a key name in materials, got {}", reader_.describe(key)));
+            key, fmt::format("expected a key name in {}, got {}", section, reader_.describe(key)));
         continue;
       }
-      add(EntityKind::MaterialEntity, static_cast<std::uint32_t>(i), tree().value(e->value, i), key,
-          key);
+      add(kind, static_cast<std::uint32_t>(i), tree().value(e->value, i), key, key);
     }
   }
 

@@ -278,7 +278,10 @@ TEST(SceneParser, WrongTypesAtTheValue) {
                  "6 hexadecimal digits");
   expectOneError(
       std::string(kMinimal) + "materials: {m: {kd: {r: 1}}}\n", 3, 21,
-      "materials.m.kd: expected a number or a list of 3 numbers [r, g, b], got a mapping");
+      "materials.m.kd is missing required key 'type' (one of: checker, checker2d, noise, marble, "
+      "wood, image)");  // a mapping is a texture
+  expectOneError(std::string(kMinimal) + "materials: {m: {kd: [1, 2]}}\n", 3, 21,
+                 "materials.m.kd: expected a list of 3 numbers [r, g, b], got a list of 2 items");
   expectOneError(std::string(kMinimal) + "objects: {type: sphere}\n", 3, 10,
                  "objects: expected a list of objects, got a mapping");
   expectOneError(
