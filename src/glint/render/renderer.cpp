@@ -190,9 +190,10 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
 
 // Direct lighting (DESIGN.md §3) with the shading normal ns (= n except on smooth meshes) in the
 // diffuse term and in r. The side tests and the shadow ray's origin use the geometric n; a light on
-// the other side of ns than of n gives no diffuse term.
-Color directLight(const TraceContext& ctx, const ShadingPoint& sp, const SampleStream& stream,
-                  bool split) {
+// the other side of ns than of n gives no diffuse term. Inlined into both shading paths (plain and
+// textured): a call here measured +0.9 % instructions on untextured scenes.
+[[gnu::always_inline]] inline Color directLight(const TraceContext& ctx, const ShadingPoint& sp,
+                                                const SampleStream& stream, bool split) {
   Color sum;
   // Nothing for a light to act on: skip the shadow rays too.
   if (isBlack(sp.material.kd) && !sp.hasSpecular) return sum;
