@@ -566,6 +566,21 @@ TEST_F(Cli, MaxMemoryAcceptsUnitsAndRefusesTooSmallABudget) {
   EXPECT_EQ(filesIn(work_), std::set<std::string>{"out.png"});
 }
 
+TEST_F(Cli, TexturesCountAgainstTheMemoryBudgetBeforeTheyAreDecoded) {
+  // scenes/textures.yaml's sky is a 1024 × 512 HDR: 8.4 MB as a float mip-map, estimated from its
+  // header. At 96 pixels wide the film is small; with the named textures before it (3.1 MiB) the
+  // sky does not fit in 4 MB.
+  const std::string scene = (fs::path(GLINT_SOURCE_DIR) / "scenes/textures.yaml").string();
+  const RunResult r =
+      run({"render", scene, "-o", "out.png", "--width", "96", "--max-memory", "4M"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "textures.yaml:9:")) << r.err;
+  EXPECT_TRUE(contains(r.err, "cannot load texture file 'textures/sky.hdr'")) << r.err;
+  EXPECT_TRUE(contains(r.err, "HDR 1024×512 image needs about 8.0 MiB")) << r.err;
+  EXPECT_TRUE(contains(r.err, "more than the memory limit of 4.0 MiB")) << r.err;
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
 TEST_F(Cli, MaxMemoryWithABadSizeIsAnArgumentError) {
   for (const char* size : {"abc", "0", "-5", "12Q", "1.5.2G", "", "G", "0.1", "99999999999T"}) {
     const RunResult r = run({"render", small(), "-o", "out.png", "--max-memory", size});

@@ -306,6 +306,18 @@ TEST(TextureRender, GlbBaseColorTextureIsApplied) {
   EXPECT_LT(m.meanDifference, 0.03);
 }
 
+TEST(TextureRender, GltfDataUriBaseColorTextureIsApplied) {
+  const fs::path gltf = kModels / "glTF2/BoxTextured-glTF-Embedded/BoxTextured.gltf";
+  if (!fs::exists(gltf)) GTEST_SKIP() << "assimp-testmodels is not installed";
+  // The same cube with its picture as a base64 data: URI inside the JSON.
+  const TextureMatch m =
+      matchMeshTexture(gltf, "{ position: [1.2, 1.4, 2.2], look_at: [0, 0, 0], fov: 40 }",
+                       {kModels / "glTF2/BoxTextured-glTF/CesiumLogoFlat.png"}, 480);
+  ASSERT_GT(m.pixels, 1000);
+  EXPECT_GT(m.spread, 0.2);
+  EXPECT_LT(m.meanDifference, 0.03);
+}
+
 TEST(TextureRender, GltfNormalTextureTiltsTheShadingNormal) {
   const fs::path gltf = kModels / "glTF2/ClearCoat-glTF/ClearCoatTest.gltf";
   if (!fs::exists(gltf)) GTEST_SKIP() << "assimp-testmodels is not installed";
