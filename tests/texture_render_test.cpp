@@ -18,6 +18,7 @@
 #include "glint/geometry/surface_coordinates.h"
 #include "glint/image/image_decoder.h"
 #include "glint/image/image_writer.h"
+#include "glint/job/checkpoint.h"
 #include "glint/render/renderer.h"
 #include "glint/render/texturing.h"
 #include "glint/scene/scene.h"
@@ -407,6 +408,26 @@ TEST(TextureRender, SameBytesOnThreadsAndStitchedCrops) {
   EXPECT_EQ(
       std::memcmp(a.pixels().data(), stitched.pixels().data(), a.pixels().size() * sizeof(Color)),
       0);
+}
+
+TEST(TextureRender, ACheckpointBelongsToTheTexturesItWasRenderedWith) {
+  // The picture is not in the scene file's bytes: the render fingerprint hashes its pixels, so a
+  // checkpoint is not resumed after the texture file changed.
+  const fs::path folder = scratchFolder() / "fingerprint";
+  fs::create_directories(folder);
+  writeTwoByTwo(folder);
+  const std::string text =
+      std::string(kAmbientOnly).substr(0, std::string(kAmbientOnly).find("textures:")) +
+      "objects:\n  - { type: sphere, center: [0, 0.6, 0], radius: 1, material: "
+      "{ kd: { type: image, file: two.png } } }\n";
+  const Scene before = sceneOf(text, folder);
+  const CheckpointSettings settings = checkpointSettingsFor(before, PixelRegion{0, 0, 48, 36}, 16);
+  const std::uint64_t a = renderFingerprint(text, before, settings);
+  EXPECT_EQ(a, renderFingerprint(text, sceneOf(text, folder), settings));
+  Film other(2, 2, PixelRegion{0, 0, 2, 2});
+  other.at(0, 0) = Color(0.5, 0, 0);
+  writeImage(other, folder / "two.png", Encoding::Linear);
+  EXPECT_NE(a, renderFingerprint(text, sceneOf(text, folder), settings));
 }
 
 TEST(TextureRender, TextureFilesAreCheckedAndBudgeted) {

@@ -33,6 +33,10 @@ class MipMap {
   int levels() const { return static_cast<int>(levels_.size()); }
   int width(int level) const { return levels_[static_cast<std::size_t>(level)].width; }
   int height(int level) const { return levels_[static_cast<std::size_t>(level)].height; }
+  // A level's texels, 3 floats each, rows from the top.
+  const std::vector<float>& pixels(int level) const {
+    return levels_[static_cast<std::size_t>(level)].pixels;
+  }
   // Texel (x, y) of a level, row y from the top; both wrap around.
   Color texel(int level, int x, int y) const;
 
