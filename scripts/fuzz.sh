@@ -5,7 +5,8 @@
 #   scripts/fuzz.sh [SECONDS | --total SECONDS] [--only NAME]... [-- LIBFUZZER_FLAGS...]
 #
 # SECONDS per fuzz target, default 60; --total SECONDS shares that time among the targets (CI).
-# --only NAME runs that target only (scene_loader, mesh_obj, mesh_ply, mesh_stl, mesh_gltf).
+# --only NAME runs that target only (scene_loader, mesh_obj, mesh_ply, mesh_stl, mesh_gltf,
+# image_header, image_decode, mesh_texture).
 # Longer runs: `scripts/fuzz.sh 3600`; on both cores: `scripts/fuzz.sh 3600 -- -fork=2`.
 # The working corpus BUILD/corpus/NAME/ persists between runs (it grows), seeded from
 # fuzz/corpus/NAME/ and, for the scene loader, scenes/*.yaml. A finding (crash, sanitizer report,
@@ -18,7 +19,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
 
-usage() { sed -n '2,18s/^# \{0,1\}//p' "${BASH_SOURCE[0]}" >&2; }
+usage() { sed -n '2,19s/^# \{0,1\}//p' "${BASH_SOURCE[0]}" >&2; }
 
 seconds=60
 total=0

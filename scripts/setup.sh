@@ -24,7 +24,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # tests read Debian's assimp-testmodels).
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
-  libyaml-dev libpng-dev libopenexr-dev libtbb-dev libcli11-dev libfmt-dev
+  libyaml-dev libpng-dev libjpeg62-turbo-dev libopenexr-dev libtbb-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libassimp-dev assimp-testmodels
 )

@@ -222,6 +222,10 @@ const std::vector<BrokenScene> kBrokenScenes{
     {"adaptive_max_below_samples.yaml", "10:28", {"max_samples", "image.samples"}},
     {"adaptive_threshold_zero.yaml", "9:43", {"threshold"}},
     {"aperture_without_focus.yaml", "6:13", {"focus_distance", "look_at"}},
+    {"undefined_texture.yaml", "12:67", {"undefined texture 'tyles'", "did you mean 'tiles'"}},
+    {"unknown_texture_type.yaml", "10:18", {"chequer", "checker2d"}},
+    {"missing_texture_file.yaml", "10:88", {"nowhere.png", "no such file"}},
+    {"unknown_background_type.yaml", "9:21", {"skybox", "gradient or image"}},
 };
 
 TEST_F(Cli, BrokenScenesExitTwoNamingFileLineAndColumn) {
@@ -560,6 +564,21 @@ TEST_F(Cli, MaxMemoryAcceptsUnitsAndRefusesTooSmallABudget) {
   EXPECT_TRUE(contains(r.err, "needs 72.0 KiB")) << r.err;
   EXPECT_TRUE(contains(r.err, "memory budget of 30.0 KiB")) << r.err;
   EXPECT_EQ(filesIn(work_), std::set<std::string>{"out.png"});
+}
+
+TEST_F(Cli, TexturesCountAgainstTheMemoryBudgetBeforeTheyAreDecoded) {
+  // scenes/textures.yaml's sky is a 1024 × 512 HDR: 8.4 MB as a float mip-map, estimated from its
+  // header. At 96 pixels wide the film is small; with the named textures before it (3.1 MiB) the
+  // sky does not fit in 4 MB.
+  const std::string scene = (fs::path(GLINT_SOURCE_DIR) / "scenes/textures.yaml").string();
+  const RunResult r =
+      run({"render", scene, "-o", "out.png", "--width", "96", "--max-memory", "4M"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "textures.yaml:9:")) << r.err;
+  EXPECT_TRUE(contains(r.err, "cannot load texture file 'textures/sky.hdr'")) << r.err;
+  EXPECT_TRUE(contains(r.err, "HDR 1024×512 image needs about 8.0 MiB")) << r.err;
+  EXPECT_TRUE(contains(r.err, "more than the memory limit of 4.0 MiB")) << r.err;
+  EXPECT_TRUE(filesIn(work_).empty());
 }
 
 TEST_F(Cli, MaxMemoryWithABadSizeIsAnArgumentError) {

@@ -282,6 +282,13 @@ void validateMesh(const TriangleMesh& mesh, std::size_t m) {
                                 " normals for " + std::to_string(mesh.positions.size()) +
                                 " positions");
   }
+  for (const auto& [what, count] :
+       {std::pair{"uvs", mesh.uvs.size()}, std::pair{"tangents", mesh.tangents.size()}}) {
+    if (count != 0 && count != mesh.positions.size()) {
+      throw std::invalid_argument(meshName(m) + " has " + std::to_string(count) + " " + what +
+                                  " for " + std::to_string(mesh.positions.size()) + " positions");
+    }
+  }
   const std::size_t positions = mesh.positions.size();
   const auto bad = std::find_if(mesh.indices.begin(), mesh.indices.end(),
                                 [positions](std::uint32_t i) { return i >= positions; });
@@ -448,24 +455,31 @@ void Aggregate::storeInLeafOrder(const std::vector<bvh::BuildItem>& items) {
     }
     std::vector<Point3> positions(vertices);
     std::vector<Normal3> normals(mesh.normals.empty() ? 0 : vertices);
+    std::vector<Point2> uvs(mesh.uvs.empty() ? 0 : vertices);
+    std::vector<VertexTangent> tangents(mesh.tangents.empty() ? 0 : vertices);
     for (std::size_t old = 0; old < vertexOf.size(); ++old) {
       const std::uint32_t v = vertexOf[old];
       if (v == kUnused) continue;
       positions[v] = mesh.positions[old];
       if (!normals.empty()) normals[v] = mesh.normals[old];
+      if (!uvs.empty()) uvs[v] = mesh.uvs[old];
+      if (!tangents.empty()) tangents[v] = mesh.tangents[old];
     }
     mesh.indices = std::move(indices);
     mesh.positions = std::move(positions);
     mesh.normals = std::move(normals);
+    mesh.uvs = std::move(uvs);
+    mesh.tangents = std::move(tangents);
   });
 }
 
 std::size_t Aggregate::memoryBytes() const {
   std::size_t bytes = 0;
   for (const TriangleMesh& mesh : meshes_) {
-    bytes += mesh.positions.capacity() * sizeof(Point3) +
-             mesh.normals.capacity() * sizeof(Normal3) +
-             mesh.indices.capacity() * sizeof(std::uint32_t);
+    bytes +=
+        mesh.positions.capacity() * sizeof(Point3) + mesh.normals.capacity() * sizeof(Normal3) +
+        mesh.indices.capacity() * sizeof(std::uint32_t) + mesh.uvs.capacity() * sizeof(Point2) +
+        mesh.tangents.capacity() * sizeof(VertexTangent);
   }
   bytes += primitives_.capacity() * sizeof(Primitive) + transmission_.capacity() * sizeof(Color) +
            meshTransmission_.capacity() * sizeof(Color) +

@@ -39,6 +39,8 @@ struct BuildOptions {
   const std::atomic<bool>* cancel = nullptr;
 };
 
+class TextureLibrary;
+
 // The state the factories of one scene share.
 struct BuildContext {
   const BuildOptions& options;
@@ -47,6 +49,7 @@ struct BuildContext {
   Encoding encoding = Encoding::Srgb;  // set once the image entity is built
   bool imageOk = false;                // the image entity built without error
   ImageSize sceneImage;                // the image size the scene asked for, before overrides
+  TextureLibrary* textures = nullptr;  // the scene's textures and their image files
 };
 
 // The parameters of an entity that must be a mapping, or nullopt after the error

@@ -1,29 +1,65 @@
 #include "glint/factories/material_factory.h"
 
 #include "glint/factories/build_context.h"
+#include "glint/factories/texture_library.h"
 
 namespace glint {
 
 const std::vector<std::string_view>& materialKeys() {
-  static const std::vector<std::string_view> keys = {
-      "kd", "ks", "shininess", "kr", "kt", "ka", "ior", "reflection_blur", "refraction_blur"};
+  static const std::vector<std::string_view> keys = {"kd",
+                                                     "ks",
+                                                     "shininess",
+                                                     "kr",
+                                                     "kt",
+                                                     "ka",
+                                                     "ior",
+                                                     "reflection_blur",
+                                                     "refraction_blur",
+                                                     "normal_map",
+                                                     "bump_map",
+                                                     "bump_scale"};
   return keys;
 }
 
-std::optional<Material> readMaterial(ParameterDictionary& params) {
+std::optional<Material> readMaterial(ParameterDictionary& params, TextureLibrary* textures) {
   params.declare(materialKeys());
   const std::size_t errorsBefore = params.errors();
   Material out;
-  if (const auto c = readCoefficient(params, "kd")) out.kd = *c;
-  if (const auto c = readCoefficient(params, "ks")) out.ks = *c;
+  MaterialTextures bindings;
+  bool textured = false;
+  // A colour key: a coefficient, or (with a texture library) a texture whose colour it becomes.
+  const auto coefficient = [&](std::string_view key, Color& value, TextureId& texture) {
+    if (textures != nullptr && textures->isTexture(params, key)) {
+      if (const auto id = textures->read(params, key, TextureRole::Color)) {
+        value = Color(1);
+        texture = *id;
+        textured = true;
+      }
+      return;
+    }
+    if (const auto c = readCoefficient(params, key)) value = *c;
+  };
+  coefficient("kd", out.kd, bindings.kd);
+  coefficient("ks", out.ks, bindings.ks);
   if (const auto v = readNonNegative(params, "shininess")) out.shininess = *v;
-  if (const auto c = readCoefficient(params, "kr")) out.kr = *c;
-  if (const auto c = readCoefficient(params, "kt")) out.kt = *c;
-  if (const auto c = readCoefficient(params, "ka")) out.ka = *c;
+  coefficient("kr", out.kr, bindings.kr);
+  coefficient("kt", out.kt, bindings.kt);
+  coefficient("ka", out.ka, bindings.ka);
   if (const auto v = readPositive(params, "ior")) out.ior = *v;
   if (const auto v = readNonNegative(params, "reflection_blur")) out.reflectionBlur = *v;
   if (const auto v = readNonNegative(params, "refraction_blur")) out.refractionBlur = *v;
+  if (textures != nullptr) {
+    for (const auto& [key, slot] :
+         {std::pair{"normal_map", &bindings.normalMap}, std::pair{"bump_map", &bindings.bumpMap}}) {
+      if (const auto id = textures->read(params, key, TextureRole::Data)) {
+        *slot = *id;
+        textured = true;
+      }
+    }
+    if (const auto v = params.number("bump_scale")) bindings.bumpScale = v->value;
+  }
   if (params.errors() != errorsBefore) return std::nullopt;
+  if (textured) out.textures = textures->addBindings(bindings);
   return out;
 }
 

@@ -14,8 +14,14 @@ namespace glint {
 // The keys of a material, in the order messages list them.
 const std::vector<std::string_view>& materialKeys();
 
+class TextureLibrary;
+
 // Declares and reads the material keys of `params`; nullopt when a value is out of range or of
-// the wrong type (reported at the value). Absent keys keep Material's defaults.
-std::optional<Material> readMaterial(ParameterDictionary& params);
+// the wrong type (reported at the value). Absent keys keep Material's defaults. With `textures`,
+// a colour key may name or describe a texture (its constant is then 1, the texture's colour
+// replacing it), and normal_map, bump_map and bump_scale are read; the bindings are added to the
+// scene and indexed by Material::textures.
+std::optional<Material> readMaterial(ParameterDictionary& params,
+                                     TextureLibrary* textures = nullptr);
 
 }  // namespace glint

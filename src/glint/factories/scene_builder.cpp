@@ -17,9 +17,12 @@
 #include "glint/core/transform.h"
 #include "glint/factories/light_factories.h"
 #include "glint/factories/material_factory.h"
+#include "glint/factories/mesh_textures.h"
 #include "glint/factories/object_factories.h"
 #include "glint/factories/settings_factories.h"
+#include "glint/factories/texture_library.h"
 #include "glint/factories/transform_reader.h"
+#include "glint/geometry/surface_coordinates.h"
 #include "glint/mesh/mesh_loader.h"
 #include "glint/readers/spelling.h"
 
@@ -46,8 +49,13 @@ class Builder {
       : d_(description),
         options_(options),
         parts_(result.parts),
-        ctx_{options, sink_, result.parts, Encoding::Srgb, false, {}},
-        result_(result) {
+        ctx_{options, sink_, result.parts, Encoding::Srgb, false, {}, nullptr},
+        result_(result),
+        textures_(description, ctx_, [this] {
+          return static_cast<double>(filmBytes(parts_.image.width, parts_.image.height)) +
+                 meshCache_.meshBytes();
+        }) {
+    ctx_.textures = &textures_;
     for (const ObjectFactory& f : objectFactories()) objectTypes_.push_back(f.type);
     for (const ObjectFactory& f : options_.extraObjectFactories) objectTypes_.push_back(f.type);
     for (const LightFactory& f : lightFactories()) lightTypes_.push_back(f.type);
@@ -64,6 +72,9 @@ class Builder {
     }
     if (const Entity* render = d_.first(EntityKind::RenderEntity)) buildRender(d_, *render, ctx_);
     if (options_.overrides.seed) parts_.render.seed = *options_.overrides.seed;
+    for (const Entity& e : d_.entities) {
+      if (e.kind == EntityKind::TextureEntity) textures_.buildNamed(e);
+    }
     if (const Entity* background = d_.first(EntityKind::BackgroundEntity)) {
       buildBackground(d_, *background, ctx_);
     }
@@ -119,11 +130,12 @@ class Builder {
     const std::string path = "materials." + name;
     auto params = entityParameters(reader, e.value, e.name,
                                    "a mapping of material keys (kd, ks, shininess, kr, kt, ka, "
-                                   "ior, reflection_blur, refraction_blur)",
+                                   "ior, reflection_blur, refraction_blur, normal_map, bump_map, "
+                                   "bump_scale)",
                                    {"in material '" + name + "'", path, path});
     std::optional<Material> material;
     if (params) {
-      material = readMaterial(*params);
+      material = readMaterial(*params, &textures_);
       params->finish();
     }
     // Kept even when it has errors, so objects naming it do not also report it undefined.
@@ -138,7 +150,7 @@ class Builder {
     if (tree.isMap(entry->value)) {
       const std::string path = owner + ".material";
       ParameterDictionary inline_(reader, entry->value, {"in " + path, path, path});
-      const std::optional<Material> material = readMaterial(inline_);
+      const std::optional<Material> material = readMaterial(inline_, &textures_);
       inline_.finish();
       if (!material) return {0, true};
       parts_.materials.push_back(*material);
@@ -240,9 +252,18 @@ class Builder {
     params.declare(factory->keys);
     params.declare({"material", "emission", "transform"});
 
-    const MaterialChoice material = resolveMaterial(params, type);
+    MaterialChoice material = resolveMaterial(params, type);
     const bool hasEmission = params.has("emission");
-    const std::optional<Color> emission = readColor(params, "emission", ctx_.encoding);
+    // `emission` is a colour, or a texture: then the object's own copy of its material carries it
+    // and the constant is 1.
+    std::optional<Color> emission;
+    std::optional<TextureId> emissionTexture;
+    if (textures_.isTexture(params, "emission")) {
+      emissionTexture = textures_.read(params, "emission", TextureRole::Color);
+      if (emissionTexture) emission = Color(1);
+    } else {
+      emission = readColor(params, "emission", ctx_.encoding);
+    }
     const TransformResult transform = readTransform(params, type);
     std::optional<ObjectGeometry> geometry;
     std::optional<ShapeError> degenerate;
@@ -260,9 +281,10 @@ class Builder {
     if (auto* request = std::get_if<MeshRequest>(&*geometry)) {
       buildMesh(params, *request, material,
                 hasEmission ? emission.value_or(Color()) : std::optional<Color>(),
-                transform.worldFromObject);
+                transform.worldFromObject, emissionTexture);
       return;
     }
+    if (emissionTexture) material.index = withEmissionTexture(material.index, *emissionTexture);
     try {
       parts_.primitives.emplace_back(std::move(std::get<Shape>(*geometry)), material.index,
                                      emission.value_or(Color()), transform.worldFromObject);
@@ -272,15 +294,37 @@ class Builder {
     }
   }
 
+  // A copy of material `index` whose emission is the texture `emission` (times the object's
+  // emission constant).
+  std::uint32_t withEmissionTexture(std::uint32_t index, TextureId emission) {
+    Material m = parts_.materials[index];
+    MaterialTextures bindings =
+        m.textures != kUntextured ? parts_.materialTextures[m.textures] : MaterialTextures{};
+    bindings.emission = emission;
+    m.textures = textures_.addBindings(bindings);
+    parts_.materials.push_back(m);
+    return static_cast<std::uint32_t>(parts_.materials.size() - 1);
+  }
+
   // The scene-material index of every material of `file`, added to the scene the first time the
-  // file is used without a material override (a file used twice shares them).
-  const std::vector<std::uint32_t>& fileMaterials(const MeshFile& file) {
+  // file is used without a material override (a file used twice shares them), with the textures
+  // its materials name (mesh_textures.cpp). Throws ImageReadError naming the texture file.
+  const std::vector<std::uint32_t>& fileMaterials(const MeshFile& file,
+                                                  const std::filesystem::path& meshPath,
+                                                  const std::filesystem::path& sceneFolder) {
     std::vector<std::uint32_t>& indices = fileMaterials_[&file];
     if (indices.empty()) {
+      std::vector<std::uint32_t> added;
       for (const MeshMaterial& m : file.materials) {
-        indices.push_back(static_cast<std::uint32_t>(parts_.materials.size()));
-        parts_.materials.push_back(m.material);
+        Material material = m.material;
+        if (m.textured()) {
+          material.textures = textures_.addBindings(
+              meshMaterialTextures(file, m, meshPath, sceneFolder, textures_));
+        }
+        added.push_back(static_cast<std::uint32_t>(parts_.materials.size()));
+        parts_.materials.push_back(material);
       }
+      indices = std::move(added);
     }
     return indices;
   }
@@ -292,7 +336,8 @@ class Builder {
   // one warning there.
   void buildMesh(ParameterDictionary& params, const MeshRequest& request,
                  const MaterialChoice& material, const std::optional<Color>& emission,
-                 const std::optional<Transform>& worldFromFile) {
+                 const std::optional<Transform>& worldFromFile,
+                 const std::optional<TextureId>& emissionTexture) {
     const std::filesystem::path written(request.file);
     const std::filesystem::path path =
         written.is_relative() ? baseDirectory(params) / written : written;
@@ -303,7 +348,8 @@ class Builder {
       file = meshCache_.load(
           path,
           MeshBudget{options_.imageMemoryBudget,
-                     filmBytes(parts_.image.width, parts_.image.height)},
+                     filmBytes(parts_.image.width, parts_.image.height) +
+                         static_cast<std::uint64_t>(textures_.bytes())},
           MeshReadOptions{.sceneFolder = baseDirectory(params), .cancel = options_.cancel});
     } catch (const MeshLoadError& e) {
       std::string reason = e.what();
@@ -331,15 +377,51 @@ class Builder {
                                 shown, file->droppedTriangles,
                                 file->droppedTriangles == 1 ? "" : "s", triangles));
     }
+    const std::vector<std::uint32_t>* scene = nullptr;
+    if (!material.given) {
+      try {
+        scene = &fileMaterials(*file, path, baseDirectory(params));
+      } catch (const ImageReadError& e) {
+        params.error(params.place(), fmt::format("mesh file '{}': {}", shown, e.what()));
+        return;
+      }
+    }
+    // The scene material of each part: the object's, or the file's own; with an emission texture,
+    // a copy carrying it.
+    std::vector<std::uint32_t> partMaterial;
+    bool anyUv = false;
+    for (const TriangleMesh& part : file->parts) {
+      std::uint32_t index = material.given ? material.index : (*scene)[part.materialIndex];
+      if (emissionTexture) index = withEmissionTexture(index, *emissionTexture);
+      partMaterial.push_back(index);
+      anyUv = anyUv || needsUv(index);
+    }
     std::vector<TriangleMesh> meshes =
-        instantiateMesh(*file, worldFromFile, request.smooth, options_.cancel);
-    const std::vector<std::uint32_t>* scene = material.given ? nullptr : &fileMaterials(*file);
-    for (TriangleMesh& mesh : meshes) {
+        instantiateMesh(*file, worldFromFile, request.smooth, options_.cancel, anyUv);
+    const auto objectTransform =
+        worldFromFile ? std::make_shared<const Transform>(*worldFromFile) : nullptr;
+    for (std::size_t k = 0; k < meshes.size(); ++k) {
+      TriangleMesh& mesh = meshes[k];
       const MeshMaterial& own = file->materials[mesh.materialIndex];
       mesh.emission = emission.value_or(material.given ? Color() : own.emission);
-      mesh.materialIndex = material.given ? material.index : (*scene)[mesh.materialIndex];
+      mesh.materialIndex = partMaterial[k];
+      mesh.worldFromObject = objectTransform;
+      if (!needsUv(mesh.materialIndex)) {
+        std::vector<Point2>().swap(mesh.uvs);
+      } else if (needsTangents(mesh.materialIndex)) {
+        computeMeshTangents(mesh);
+      }
       parts_.meshes.push_back(std::move(mesh));
     }
+  }
+
+  bool needsUv(std::uint32_t material) const {
+    const std::uint32_t t = parts_.materials[material].textures;
+    return t != kUntextured && parts_.materialTextures[t].needsUv;
+  }
+  bool needsTangents(std::uint32_t material) const {
+    const std::uint32_t t = parts_.materials[material].textures;
+    return t != kUntextured && parts_.materialTextures[t].normalMap != kNoTexture;
   }
 
   std::filesystem::path baseDirectory(const ParameterDictionary& params) const {
@@ -478,6 +560,7 @@ class Builder {
   std::vector<ObjectPlace> objectPlaces_;      // per primitive, where its object was written
   std::vector<std::string_view> objectTypes_;  // in the order messages list them
   std::vector<std::string_view> lightTypes_;
+  TextureLibrary textures_;  // the scene's textures; ctx_.textures points here
 };
 
 }  // namespace

@@ -1,10 +1,14 @@
 #include "glint/factories/settings_factories.h"
 
+#include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
+#include "glint/factories/texture_library.h"
 #include "glint/readers/spelling.h"
 #include "glint/scene/camera.h"
 
@@ -174,8 +178,69 @@ void buildAmbient(const SceneDescription& scene, const Entity& e, BuildContext& 
   p.finish();
 }
 
+namespace {
+
+// background: {type: gradient, zenith, horizon, nadir} or {type: image, file, intensity, rotate,
+// encoding} (DESIGN.md §9).
+void buildEnvironment(const ValueReader& reader, const Entity& e, BuildContext& ctx) {
+  ParameterDictionary p(reader, e.value, {"in background", "background", "background"});
+  p.declareHidden("type");
+  const auto type = p.text("type", kRequired);
+  Environment environment;
+  if (type && type->value == "gradient") {
+    p.declare({"zenith", "horizon", "nadir"});
+    environment.kind = BackgroundKind::Gradient;
+    const auto zenith = readColor(p, "zenith", ctx.encoding);
+    const auto horizon = readColor(p, "horizon", ctx.encoding);
+    if (!p.has("zenith")) p.requireKey("zenith");
+    if (!p.has("horizon")) p.requireKey("horizon");
+    const auto nadir = readColor(p, "nadir", ctx.encoding);
+    environment.zenith = zenith.value_or(Color());
+    environment.horizon = horizon.value_or(Color());
+    environment.nadir = nadir.value_or(environment.horizon);
+  } else if (type && type->value == "image") {
+    p.declare({"file", "intensity", "rotate", "encoding"});
+    environment.kind = BackgroundKind::Image;
+    const auto file = p.text("file", kRequired);
+    environment.intensity = readNonNegative(p, "intensity").value_or(1);
+    if (const auto rotate = p.number("rotate")) {
+      const double radians = rotate->value * std::numbers::pi / 180;
+      environment.cosRotate = std::cos(radians);
+      environment.sinRotate = std::sin(radians);
+    }
+    ImageEncoding encoding = ImageEncoding::Srgb;
+    if (const auto text = p.text("encoding")) {
+      if (text->value == "linear") {
+        encoding = ImageEncoding::Linear;
+      } else if (text->value != "srgb") {
+        p.error(text->where, fmt::format("background.encoding: expected srgb or linear, got {}",
+                                         quoteForMessage(text->value)));
+      }
+    }
+    if (file && p.errors() == 0 && ctx.textures != nullptr) {
+      environment.image = ctx.textures->image(p, file->where, file->value, encoding);
+    }
+  } else if (type) {
+    p.error(
+        type->where,
+        fmt::format("unknown background type {}; expected gradient or image (or give a colour "
+                    "instead of a mapping){}",
+                    quoteForMessage(type->value),
+                    didYouMean(type->value, std::vector<std::string_view>{"gradient", "image"})));
+    p.markUsed(p.keys());
+  }
+  p.finish();
+  if (p.errors() == 0) ctx.parts.environment = std::move(environment);
+}
+
+}  // namespace
+
 void buildBackground(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
   const ValueReader reader = readerOf(scene, e, ctx);
+  if (reader.tree().isMap(e.value)) {
+    buildEnvironment(reader, e, ctx);
+    return;
+  }
   // A single colour: read as the one value of a dictionary-less entity.
   const ValuePath path{nullptr, "background", {}, ValuePath::kNoIndex};
   const std::size_t before = ctx.sink.errorCount();

@@ -204,6 +204,8 @@ class Primitive {
   Bounds3 bounds() const { return bounds_; }
   bool isBounded() const { return bounds_.isBounded(); }
   const Shape& shape() const { return shape_; }
+  // Its transform, or null when the shape is already in world space.
+  const Transform* worldFromObject() const { return worldFromObject_.get(); }
   std::uint32_t materialIndex() const { return materialIndex_; }
   const Color& emission() const { return emission_; }
 

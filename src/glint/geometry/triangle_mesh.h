@@ -4,12 +4,22 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "glint/core/color.h"
+#include "glint/core/transform.h"
 #include "glint/core/vec.h"
 
 namespace glint {
+
+// A vertex's tangent for tangent-space normal maps: the direction of increasing u (unit, orthogonal
+// to the vertex normal) and the sign of the bitangent: n × direction points along increasing v
+// when +1, against it when −1 (a mirrored uv layout).
+struct VertexTangent {
+  Vec3 direction;
+  double sign = 1;
+};
 
 // One mesh with one material. A file with several materials becomes several TriangleMeshes.
 // Triangles are intersected with the same watertight test as Triangle (Woop, Benthin, Wald 2013);
@@ -18,7 +28,14 @@ struct TriangleMesh {
   std::vector<Point3> positions;       // world space, scene units (any transform already applied)
   std::vector<Normal3> normals;        // per vertex, unit, world space; empty: flat shading
   std::vector<std::uint32_t> indices;  // three per triangle, into positions (and normals)
-  std::uint32_t materialIndex = 0;     // into SceneParts::materials
+  // Texture coordinates per vertex, (0, 0) at an image's bottom-left (DESIGN.md §9); empty: none
+  // (only meshes whose material is textured keep them).
+  std::vector<Point2> uvs;
+  std::vector<VertexTangent> tangents;  // per vertex, world space; empty unless normal-mapped
+  // The mesh object's transform, for solid textures (evaluated in the object's own space); null
+  // when the object has none.
+  std::shared_ptr<const Transform> worldFromObject;
+  std::uint32_t materialIndex = 0;  // into SceneParts::materials
   Color emission;
 
   std::size_t triangleCount() const { return indices.size() / 3; }

@@ -156,12 +156,29 @@ std::uint64_t renderFingerprint(std::string_view sceneFileBytes, const Scene& sc
     hash = hashVector(mesh.positions, hash);
     hash = hashVector(mesh.normals, hash);
     hash = hashVector(mesh.indices, hash);
+    // Texture coordinates, kept only by textured meshes (none: the hash is unchanged).
+    static_assert(sizeof(Point2) == 2 * sizeof(double));
+    if (!mesh.uvs.empty()) hash = hashVector(mesh.uvs, hash);
     Writer m;
     m.u32(mesh.materialIndex);
     m.f64(mesh.emission.r);
     m.f64(mesh.emission.g);
     m.f64(mesh.emission.b);
     hash = fnv1a64(m.text(), hash);
+  }
+  // The pictures of image textures and of the background, read from files the scene only names
+  // (each once; an untextured scene adds nothing).
+  std::vector<const MipMap*> images;
+  for (const Texture& texture : scene.textures()) {
+    if (const auto* t = std::get_if<ImageTexture>(&texture)) images.push_back(t->image.get());
+  }
+  if (scene.environment().image) images.push_back(scene.environment().image.get());
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    if (std::find(images.begin(), images.begin() + static_cast<std::ptrdiff_t>(i), images[i]) !=
+        images.begin() + static_cast<std::ptrdiff_t>(i)) {
+      continue;
+    }
+    hash = hashVector(images[i]->pixels(0), hash);
   }
   Writer s;
   s.i32(settings.width);

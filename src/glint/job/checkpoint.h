@@ -51,8 +51,9 @@ std::uint64_t fnv1a64(std::string_view bytes, std::uint64_t hash = kFnvOffsetBas
 
 // The fingerprint stored in a checkpoint: FNV-1a 64 over the checkpoint version, the glint
 // version, the scene file's bytes, the geometry of every loaded mesh (positions, normals,
-// indices, material index, emission: mesh files are not named in the Scene, so their content is
-// hashed as loaded) and `settings`. A different value means the checkpoint belongs to another
+// indices, texture coordinates, material index, emission: mesh files are not named in the Scene, so
+// their content is hashed as loaded), the pixels of every image texture and image background
+// (likewise) and `settings`. A different value means the checkpoint belongs to another
 // render.
 std::uint64_t renderFingerprint(std::string_view sceneFileBytes, const Scene& scene,
                                 const CheckpointSettings& settings);

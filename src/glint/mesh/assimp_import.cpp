@@ -18,6 +18,7 @@
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/texture.h>
 #include <fmt/format.h>
 #include <assimp/Importer.hpp>
 
@@ -135,6 +136,40 @@ std::string assimpReason(std::string_view message) {
 double component(float value) { return std::isfinite(value) && value > 0 ? value : 0.0; }
 Color colorOf(const aiColor3D& c) { return {component(c.r), component(c.g), component(c.b)}; }
 
+// The textures a material names (the first of each type), with the images it embeds copied into
+// `embedded` once each. An embedded image is named "*N" (glTF's buffers and data: URIs, in assimp's
+// form) or by a file name assimp found inside the file; only compressed ones (PNG, JPEG...: width
+// = their size in bytes, height 0) are kept; raw texel arrays are named like files and then fail
+// to load as such, reported by the scene builder.
+void convertTextures(const aiScene& scene, const aiMaterial& m, MeshMaterial& out,
+                     std::vector<std::vector<std::uint8_t>>& embedded,
+                     std::vector<const aiTexture*>& embeddedFrom) {
+  static constexpr std::pair<aiTextureType, MeshTextureSlot> kSlots[] = {
+      {aiTextureType_DIFFUSE, kDiffuseTexture},   {aiTextureType_BASE_COLOR, kDiffuseTexture},
+      {aiTextureType_SPECULAR, kSpecularTexture}, {aiTextureType_EMISSIVE, kEmissiveTexture},
+      {aiTextureType_NORMALS, kNormalTexture},    {aiTextureType_HEIGHT, kBumpTexture}};
+  for (const auto& [type, slot] : kSlots) {
+    MeshTexture& texture = out.textures[slot];
+    if (texture.present() || m.GetTextureCount(type) == 0) continue;
+    aiString path;
+    if (m.GetTexture(type, 0, &path) != AI_SUCCESS || path.length == 0) continue;
+    const aiTexture* image = scene.GetEmbeddedTexture(path.C_Str());
+    if (image != nullptr && image->mHeight == 0 && image->pcData != nullptr && image->mWidth > 0) {
+      const auto known = std::find(embeddedFrom.begin(), embeddedFrom.end(), image);
+      if (known == embeddedFrom.end()) {
+        const auto* bytes = reinterpret_cast<const std::uint8_t*>(image->pcData);
+        embedded.emplace_back(bytes, bytes + image->mWidth);
+        embeddedFrom.push_back(image);
+        texture.embedded = static_cast<std::int32_t>(embedded.size() - 1);
+      } else {
+        texture.embedded = static_cast<std::int32_t>(known - embeddedFrom.begin());
+      }
+      continue;
+    }
+    texture.file = path.C_Str();
+  }
+}
+
 MeshMaterial convertMaterial(const aiMaterial& m) {
   MeshMaterial out;
   aiString name;
@@ -251,6 +286,7 @@ MeshFile importMesh(const std::filesystem::path& path, const std::string& extens
 
     // Only the materials the triangles use, in order of first use.
     std::vector<std::uint32_t> materialOf(scene->mNumMaterials, kUnused);
+    std::vector<const aiTexture*> embeddedFrom;  // per embedded image, where it came from
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
       const aiMesh& mesh = *scene->mMeshes[m];
       if (joined[m].indices.empty()) continue;
@@ -261,6 +297,8 @@ MeshFile importMesh(const std::filesystem::path& path, const std::string& extens
         if (materialOf[source] == kUnused) {
           materialOf[source] = static_cast<std::uint32_t>(result.materials.size());
           result.materials.push_back(convertMaterial(*scene->mMaterials[source]));
+          convertTextures(*scene, *scene->mMaterials[source], result.materials.back(),
+                          result.embeddedImages, embeddedFrom);
         }
         part.materialIndex = materialOf[source];
       } else {

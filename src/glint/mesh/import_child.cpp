@@ -27,8 +27,8 @@
 #include <fmt/format.h>
 
 #include "glint/core/cancel.h"
-#include "glint/mesh/assimp_import.h"
 #include "glint/core/file_access.h"
+#include "glint/mesh/assimp_import.h"
 
 namespace glint {
 
@@ -41,7 +41,13 @@ namespace {
 // materials) before using it.
 
 static_assert(std::is_trivially_copyable_v<Material> && std::is_trivially_copyable_v<Color> &&
-              std::is_trivially_copyable_v<Point3> && std::is_trivially_copyable_v<Normal3>);
+              std::is_trivially_copyable_v<Point3> && std::is_trivially_copyable_v<Normal3> &&
+              std::is_trivially_copyable_v<Point2>);
+
+// Largest embedded image the answer may carry, and most of them: far beyond any real model, small
+// enough that a corrupt answer cannot make the parent allocate without end.
+constexpr std::uint64_t kMaxEmbeddedImageBytes = std::uint64_t{1} << 30;
+constexpr std::uint64_t kMaxEmbeddedImages = 1 << 16;
 
 // Writes everything or stops silently (the parent sees a short message).
 bool writeAll(int fd, const void* data, std::size_t size) {
@@ -78,12 +84,19 @@ bool writeMeshFile(int fd, const MeshFile& file) {
   for (const MeshMaterial& m : file.materials) {
     ok = ok && writeMessage(fd, 'N', m.name) && writeValue(fd, m.material) &&
          writeValue(fd, m.emission) && writeValue(fd, static_cast<char>(m.fromFile));
+    for (const MeshTexture& t : m.textures) {
+      ok = ok && writeMessage(fd, 'T', t.file) && writeValue(fd, t.embedded);
+    }
+  }
+  ok = ok && writeValue(fd, std::uint64_t{file.embeddedImages.size()});
+  for (const std::vector<std::uint8_t>& image : file.embeddedImages) {
+    ok = ok && writeVector(fd, image);
   }
   ok = ok && writeValue(fd, std::uint64_t{file.parts.size()});
   for (const TriangleMesh& part : file.parts) {
     ok = ok && writeValue(fd, part.materialIndex) && writeValue(fd, part.emission) &&
          writeVector(fd, part.positions) && writeVector(fd, part.normals) &&
-         writeVector(fd, part.indices);
+         writeVector(fd, part.indices) && writeVector(fd, part.uvs);
   }
   return ok;
 }
@@ -189,6 +202,27 @@ MeshFile receiveMeshFile(Reader& in) {
     m.material = in.value<Material>();
     m.emission = in.value<Color>();
     m.fromFile = in.value<char>() != 0;
+    // Texture bindings are the renderer's; none crosses from the child.
+    m.material.textures = kUntextured;
+    for (MeshTexture& t : m.textures) {
+      if (in.value<char>() != 'T') {
+        throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+      }
+      t.file = in.text();
+      t.embedded = in.value<std::int32_t>();
+    }
+  }
+  file.embeddedImages.resize(static_cast<std::size_t>(in.count(kMaxEmbeddedImages)));
+  for (std::vector<std::uint8_t>& image : file.embeddedImages) {
+    in.vector(image, kMaxEmbeddedImageBytes);
+  }
+  for (const MeshMaterial& m : file.materials) {
+    for (const MeshTexture& t : m.textures) {
+      if (t.embedded < -1 ||
+          (t.embedded >= 0 && static_cast<std::size_t>(t.embedded) >= file.embeddedImages.size())) {
+        throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+      }
+    }
   }
   file.parts.resize(static_cast<std::size_t>(in.count(1 << 20)));
   std::uint64_t triangles = 0;
@@ -198,9 +232,11 @@ MeshFile receiveMeshFile(Reader& in) {
     in.vector(part.positions, std::uint64_t{1} << 32);
     in.vector(part.normals, part.positions.size());
     in.vector(part.indices, 3 * kMaxMeshTriangles);
+    in.vector(part.uvs, part.positions.size());
     triangles += part.triangleCount();
     bool ok = part.materialIndex < file.materials.size() && part.indices.size() % 3 == 0 &&
               (part.normals.empty() || part.normals.size() == part.positions.size()) &&
+              (part.uvs.empty() || part.uvs.size() == part.positions.size()) &&
               triangles <= kMaxMeshTriangles;
     // In blocks, polling the cancel flag between them: a mesh may hold hundreds of millions.
     constexpr std::size_t kBlock = std::size_t{1} << 20;

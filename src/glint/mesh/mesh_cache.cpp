@@ -99,12 +99,17 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
   // The real sizes replace the estimate.
   double triangles = 0;
   double vertices = 0;
+  double uvBytes = 0;        // the file's texture coordinates (world copies keep them only when
+                             // textured: counted with the textures' bindings)
+  double embeddedBytes = 0;  // the compressed images the file embeds
   for (const TriangleMesh& part : file->parts) {
     triangles += static_cast<double>(part.triangleCount());
     vertices += static_cast<double>(part.positions.size());
+    uvBytes += static_cast<double>(part.uvs.size() * sizeof(Point2));
   }
-  const double bytes =
-      (cached ? 0 : meshCopyBytes(triangles, vertices)) + meshInstanceBytes(triangles, vertices);
+  for (const auto& image : file->embeddedImages) embeddedBytes += static_cast<double>(image.size());
+  const double bytes = (cached ? 0 : meshCopyBytes(triangles, vertices) + uvBytes + embeddedBytes) +
+                       meshInstanceBytes(triangles, vertices);
   if (meshBytes_ + bytes + static_cast<double>(budget.otherBytes) >
       static_cast<double>(budget.limit)) {
     const std::string what =

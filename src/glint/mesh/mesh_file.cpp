@@ -34,7 +34,7 @@ MeshFile readMeshFile(const std::filesystem::path& path, const MeshReadOptions& 
 
 std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
                                           const std::optional<Transform>& worldFromFile,
-                                          bool smooth, const std::atomic<bool>* cancel) {
+                                          bool smooth, const std::atomic<bool>* cancel, bool uvs) {
   bool mirror = false;
   if (worldFromFile) {
     const auto& m = worldFromFile->matrix().m;
@@ -53,6 +53,7 @@ std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
     mesh.materialIndex = part.materialIndex;
     mesh.emission = part.emission;
     mesh.indices = part.indices;
+    if (uvs) mesh.uvs = part.uvs;
     if (mirror) {
       for (std::size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
         std::swap(mesh.indices[i + 1], mesh.indices[i + 2]);

@@ -3,6 +3,7 @@
 // world space for one mesh object (DESIGN.md §5 `mesh`).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -51,14 +52,41 @@ class MeshLoadError : public std::runtime_error {
 //   (files' own ambient colours are mostly exporter defaults: 0, 0.2 or 1);
 //   specular colour → ks, shininess (Phong exponent, AI_MATKEY_SHININESS) → shininess;
 //   emissive colour → emission; opacity < 1 → kt = 1 − opacity, with the refraction index → ior.
-// Textures, vertex colours and PBR parameters other than the base colour are ignored.
+// Textures (MeshTexture) are named, not read: the scene builder reads them (DESIGN.md §9).
+// Vertex colours and PBR parameters other than the base colour are ignored.
 // A material assimp made up because the file has none (STL, PLY, OBJ without MTL) is
 // kMeshDefaultMaterial instead, with fromFile false.
+// A texture a mesh file's material names: a file, as the mesh file wrote it (relative to the mesh
+// file's folder), or an image embedded in the mesh file (a .glb's buffers, a data: URI).
+struct MeshTexture {
+  std::string file;            // empty when embedded or absent
+  std::int32_t embedded = -1;  // index into MeshFile::embeddedImages, or -1
+  bool present() const { return !file.empty() || embedded >= 0; }
+};
+
+// The texture slots of a mesh material: OBJ/MTL map_Kd, map_Ks, map_Ke, map_Bump/bump, norm;
+// glTF baseColorTexture, emissiveTexture, normalTexture.
+enum MeshTextureSlot : std::uint8_t {
+  kDiffuseTexture,
+  kSpecularTexture,
+  kEmissiveTexture,
+  kNormalTexture,
+  kBumpTexture,
+  kMeshTextureSlots
+};
+
 struct MeshMaterial {
   std::string name;  // as in the file; may be empty
   Material material;
   Color emission;
   bool fromFile = true;
+  std::array<MeshTexture, kMeshTextureSlots> textures{};
+  bool textured() const {
+    for (const MeshTexture& t : textures) {
+      if (t.present()) return true;
+    }
+    return false;
+  }
 };
 
 // What a mesh without any material of its own looks like: mid grey, lit by lights and ambient
@@ -80,6 +108,8 @@ inline constexpr Material kMeshDefaultMaterial = [] {
 struct MeshFile {
   std::vector<TriangleMesh> parts;
   std::vector<MeshMaterial> materials;
+  // The compressed bytes (PNG, JPEG, ...) of the images the materials' textures embed.
+  std::vector<std::vector<std::uint8_t>> embeddedImages;
   // Triangles of the file that are not in `parts`: zero area (twice the area ≤ 1e-12 · longest
   // edge², the same bound as a scene's triangle), a non-finite vertex, or a vertex index out of
   // range.
@@ -121,9 +151,11 @@ MeshFile readMeshFile(const std::filesystem::path& path, const MeshReadOptions& 
 // dropped (flat shading). Material indices and emission are copied from the file; the caller maps
 // them onto the scene's materials. Polls `cancel` (may be null) as it goes and throws Cancelled
 // once it is set.
+// With `uvs` the parts' texture coordinates are copied too (else left out).
 std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
                                           const std::optional<Transform>& worldFromFile,
-                                          bool smooth, const std::atomic<bool>* cancel = nullptr);
+                                          bool smooth, const std::atomic<bool>* cancel = nullptr,
+                                          bool uvs = false);
 
 // The reason a mesh file is refused, in the user's words: "no such file", "it is a folder, not a
 // mesh file", "it is not a regular file", or the system's reason.

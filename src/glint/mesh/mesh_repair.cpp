@@ -70,15 +70,17 @@ void repairNormals(TriangleMesh& mesh) {
   }
 }
 
-// The vertex data glint keeps, as a key for joining: position and normal in assimp's float. −0 is
-// made +0 (the two compare equal), and a normal that is not finite becomes 0 — every invalid normal
-// is one class, replaced by repairNormals from the triangles around the joined vertex.
+// The vertex data glint keeps, as a key for joining: position, normal and texture coordinates (the
+// first set; (0, 0) without) in assimp's float. −0 is made +0 (the two compare equal), and a normal
+// that is not finite becomes 0 — every invalid normal is one class, replaced by repairNormals from
+// the triangles around the joined vertex.
 struct VertexKey {
   float p[3];
   float n[3];
+  float t[2];
   bool operator==(const VertexKey& o) const {
     return p[0] == o.p[0] && p[1] == o.p[1] && p[2] == o.p[2] && n[0] == o.n[0] && n[1] == o.n[1] &&
-           n[2] == o.n[2];
+           n[2] == o.n[2] && t[0] == o.t[0] && t[1] == o.t[1];
   }
 };
 
@@ -96,15 +98,22 @@ VertexKey keyOf(const aiMesh& mesh, unsigned v) {
       key.n[2] = n.z + 0.0f;
     }
   }
+  if (mesh.mTextureCoords[0] != nullptr) {
+    const aiVector3D& t = mesh.mTextureCoords[0][v];
+    // NaN ≠ NaN would never join: such coordinates become 0 (the texture lookup tames them anyway).
+    key.t[0] = std::isfinite(t.x) ? t.x + 0.0f : 0.0f;
+    key.t[1] = std::isfinite(t.y) ? t.y + 0.0f : 0.0f;
+  }
   return key;
 }
 
 std::uint64_t hashOf(const VertexKey& key) {
-  // FNV-1a over the six floats' bits (positions are finite here: triangles touching a non-finite
-  // vertex were dropped), then a 64-bit finaliser (splitmix64) to spread them over the table.
+  // FNV-1a over the eight floats' bits (positions are finite here: triangles touching a
+  // non-finite vertex were dropped), then a 64-bit finaliser (splitmix64) to spread them over the
+  // table.
   std::uint64_t h = 1469598103934665603ull;
-  for (const float* f : {key.p, key.n}) {
-    for (int i = 0; i < 3; ++i) {
+  for (const auto& [f, count] : {std::pair{key.p, 3}, std::pair{key.n, 3}, std::pair{key.t, 2}}) {
+    for (int i = 0; i < count; ++i) {
       std::uint32_t bits = 0;
       std::memcpy(&bits, &f[i], sizeof bits);
       h = (h ^ bits) * 1099511628211ull;
@@ -163,11 +172,14 @@ void splitSharedCorners(aiScene& scene) {
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) corners += mesh->mFaces[f].mNumIndices;
     if (corners == mesh->mNumVertices || corners > kMaxMeshTriangles * 3) continue;
     auto* vertices = new aiVector3D[corners];
+    // The first set of texture coordinates follows its corners; other sets are dropped.
+    aiVector3D* uvs = mesh->mTextureCoords[0] != nullptr ? new aiVector3D[corners] : nullptr;
     unsigned next = 0;
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       aiFace& face = mesh->mFaces[f];
       for (unsigned i = 0; i < face.mNumIndices; ++i) {
         vertices[next] = mesh->mVertices[face.mIndices[i]];  // checked by dropInvalidFaces
+        if (uvs != nullptr) uvs[next] = mesh->mTextureCoords[0][face.mIndices[i]];
         face.mIndices[i] = next++;
       }
     }
@@ -186,6 +198,10 @@ void splitSharedCorners(aiScene& scene) {
       delete[] mesh->mTextureCoords[k];
       mesh->mTextureCoords[k] = nullptr;
       mesh->mNumUVComponents[k] = 0;
+    }
+    if (uvs != nullptr) {
+      mesh->mTextureCoords[0] = uvs;
+      mesh->mNumUVComponents[0] = 2;
     }
   }
 }
@@ -302,6 +318,13 @@ TriangleMesh convertMesh(const aiMesh& in, JoinedMesh&& joined) {
     for (std::size_t j = 0; j < joined.source.size(); ++j) {
       const aiVector3D& n = in.mNormals[joined.source[j]];
       out.normals[j] = {n.x, n.y, n.z};
+    }
+  }
+  if (in.mTextureCoords[0] != nullptr) {
+    out.uvs.resize(joined.source.size());
+    for (std::size_t j = 0; j < joined.source.size(); ++j) {
+      const aiVector3D& t = in.mTextureCoords[0][joined.source[j]];
+      out.uvs[j] = {std::isfinite(t.x) ? t.x : 0.0, std::isfinite(t.y) ? t.y : 0.0};
     }
   }
   repairNormals(out);

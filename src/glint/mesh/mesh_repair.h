@@ -28,21 +28,21 @@ std::size_t dropInvalidFaces(aiScene& scene);
 // smooth surface got one face's normal per vertex (faceted, lopsided shading) and a crease could
 // not be kept. One vertex per corner, as assimp's OBJ and STL importers already give, lets every
 // corner average exactly the faces within the crease angle; glint's join (joinMesh) shares them
-// again afterwards. Texture coordinates and colours are dropped (glint reads neither); meshes
-// with bones are left alone (their weights index the vertices).
+// again afterwards. The first set of texture coordinates follows the corners; colours, tangents and
+// further sets are dropped (glint reads none of them); meshes with bones are left alone (their
+// weights index the vertices).
 void splitSharedCorners(aiScene& scene);
 
 // Faces of at least three corners in all meshes of the scene.
 std::size_t facesWithTriangles(const aiScene& scene);
 
 // One assimp mesh's triangles with the degenerate ones left out, over joined vertices: the
-// vertices of equal position and normal (VertexKey) are one, numbered in order of first use by
-// the kept triangles. assimp's importers give OBJ and STL one vertex per face corner; glint joins
-// them here, exactly and in O(n) with a hash table, instead of assimp's JoinIdenticalVertices
-// (which compares within an epsilon through a spatial sort, and also compares texture
-// coordinates glint does not use: ~0.1 s of a 0.3 s load for a 100k-triangle OBJ).
-// GenSmoothNormals has already run (assimp runs it before any join), so the normals of a crease
-// differ and its vertices stay split.
+// vertices of equal position, normal and texture coordinates (VertexKey) are one, numbered in order
+// of first use by the kept triangles. assimp's importers give OBJ and STL one vertex per face
+// corner; glint joins them here, exactly and in O(n) with a hash table, instead of assimp's
+// JoinIdenticalVertices (which compares within an epsilon through a spatial sort: ~0.1 s of a 0.3 s
+// load for a 100k-triangle OBJ). GenSmoothNormals has already run (assimp runs it before any join),
+// so the normals of a crease differ and its vertices stay split.
 struct JoinedMesh {
   std::vector<std::uint32_t> indices;  // three per kept triangle, into `source`
   std::vector<std::uint32_t> source;   // the assimp vertex each joined vertex copies
@@ -52,8 +52,8 @@ struct JoinedMesh {
 JoinedMesh joinMesh(const aiMesh& in, std::size_t& dropped);
 
 // One assimp mesh (triangulated, its node transforms baked), joined, → a TriangleMesh in file
-// space. Invalid vertex normals (zero or not finite) are rebuilt from the triangles around the
-// vertex.
+// space, with the first set of texture coordinates as its uvs. Invalid vertex normals (zero or not
+// finite) are rebuilt from the triangles around the vertex.
 TriangleMesh convertMesh(const aiMesh& in, JoinedMesh&& joined);
 
 }  // namespace glint

@@ -215,8 +215,9 @@ TEST(MeshRepair, CreasesKeepOneVertexPerNormal) {
 TEST(MeshRepair, SeamsOfSplitNormalsKeepBothNormals) {
   // Two triangles hinged on the edge of vertices 2 and 3. In `seam` each triangle gives the
   // shared edge its own normal (`vn`): the edge's two positions carry two normals each, so 6
-  // vertices. In `smooth` both use one normal: 4 vertices. Corners that differ only in a texture
-  // coordinate (glint does not use them) or in the sign of a zero coordinate are one vertex.
+  // vertices. In `smooth` both use one normal; corners that differ only in the sign of a zero
+  // coordinate are one vertex, corners with different texture coordinates two (a texture seam):
+  // 5 vertices.
   TempDir dir;
   const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 1\nvt 0 0\nvt 1 1\n";
   const MeshFile seam = readMeshFile(
@@ -231,10 +232,10 @@ TEST(MeshRepair, SeamsOfSplitNormalsKeepBothNormals) {
 
   const MeshFile smooth = readMeshFile(
       dir.write("smooth.obj", v + "v -0 0 -0\nvn 0 0 1\nf 5/1/1 2/1/1 3/1/1\nf 2/2/1 4/2/1 3/1/1\n"
-                                  "f 1/2/1 3/1/1 2/2/1\n"));
+                                  "f 1/1/1 3/1/1 2/2/1\n"));
   ASSERT_EQ(smooth.parts.size(), 1u);
-  EXPECT_EQ(smooth.parts[0].positions.size(), 4u);
-  const std::vector<std::uint32_t> smoothIndices{0, 1, 2, 1, 3, 2, 0, 2, 1};
+  EXPECT_EQ(smooth.parts[0].positions.size(), 5u);
+  const std::vector<std::uint32_t> smoothIndices{0, 1, 2, 3, 4, 2, 0, 2, 3};
   EXPECT_EQ(smooth.parts[0].indices, smoothIndices);
 }
 

@@ -1,5 +1,6 @@
 // SceneDescription: a scene as plain data — the files it was read from, with their values, and the
-// entities (camera, image, render settings, ambient light, background, materials, objects, lights)
+// entities (camera, image, render settings, ambient light, background, textures, materials,
+// objects, lights)
 // whose parameters are mappings of those values, each value with its file:line:col. Readers fill
 // it (YAML, and later other formats); the factories (factories/scene_builder) turn it into
 // SceneParts. No render types here.
@@ -25,6 +26,7 @@ enum class EntityKind : std::uint8_t {
   AmbientEntity,
   BackgroundEntity,
   MaterialEntity,  // a named material of `materials`
+  TextureEntity,   // a named texture of `textures`
   ObjectEntity,    // an entry of `objects`; its `type` names its factory
   LightEntity,     // an entry of `lights`; its `type` names its factory
 };
@@ -47,7 +49,7 @@ struct Entity {
   ValueId value = kNoValue;  // its mapping of parameters, or its single value (a background colour)
   ValueId place = kNoValue;  // where messages put it: its value, or its key or list when empty
   ValueId type = kNoValue;   // objects, lights: the value of its `type` key, if any
-  ValueId name = kNoValue;   // materials: its name (the key in `materials`)
+  ValueId name = kNoValue;   // materials, textures: its name (the key in its section)
 };
 
 struct SceneDescription {

@@ -41,10 +41,10 @@ yaml::Document readYamlFile(const std::filesystem::path& path, const std::string
                             const std::atomic<bool>* cancel);
 
 // The keys of a scene file's top level, and the ones an included file may hold too.
-const std::vector<std::string_view> kSceneKeys = {"name",   "background", "ambient",   "camera",
-                                                  "image",  "render",     "materials", "objects",
-                                                  "lights", "include"};
-const std::vector<std::string_view> kIncludedKeys = {"include", "materials"};
+const std::vector<std::string_view> kSceneKeys = {
+    "name", "background", "ambient", "camera", "image", "render",
+    "textures", "materials", "objects", "lights", "include"};
+const std::vector<std::string_view> kIncludedKeys = {"include", "textures", "materials"};
 
 // The sections of the top-level mapping as entities.
 class TopLevel {
@@ -67,13 +67,14 @@ class TopLevel {
       for (const std::string_view key : kSceneKeys) {
         if (top.isDeclared(key) || !top.has(key)) continue;
         top.error(top.keyPlace(key),
-                  fmt::format("'{}' belongs in the scene file: an included file holds materials "
-                              "and further includes only",
+                  fmt::format("'{}' belongs in the scene file: an included file holds textures, "
+                              "materials and further includes only",
                               key));
         top.markUsed({key});
       }
       includes(top);
-      materials(top);
+      named(top, "textures", "texture", EntityKind::TextureEntity);
+      named(top, "materials", "material", EntityKind::MaterialEntity);
       top.finish();
       return;
     }
@@ -90,7 +91,8 @@ class TopLevel {
     section(top, "camera", EntityKind::CameraEntity);
     section(top, "image", EntityKind::ImageEntity);
     section(top, "render", EntityKind::RenderEntity);
-    materials(top);
+    named(top, "textures", "texture", EntityKind::TextureEntity);
+    named(top, "materials", "material", EntityKind::MaterialEntity);
     list(top, "objects", "objects", EntityKind::ObjectEntity);
     list(top, "lights", "lights", EntityKind::LightEntity);
     top.finish();
@@ -118,25 +120,24 @@ class TopLevel {
     if (const auto e = top.find(key)) add(kind, 0, e->value, e->key);
   }
 
-  // `materials`: a mapping from names to materials, each an entity named by its key.
-  void materials(ParameterDictionary& top) {
-    const auto e = top.find("materials");
+  // `materials`, `textures`: a mapping from names to entities, each named by its key.
+  void named(ParameterDictionary& top, std::string_view section, std::string_view what,
+             EntityKind kind) {
+    const auto e = top.find(section);
     if (!e || tree().isNull(e->value)) return;  // `materials:` with nothing under it: none
     if (!tree().isMap(e->value)) {
-      top.error(e->where, fmt::format("materials: expected a mapping from material names to "
-                                      "materials, got {}",
-                                      reader_.describe(e->value)));
+      top.error(e->where, fmt::format("{}: expected a mapping from {} names to {}s, got {}",
+                                      section, what, what, reader_.describe(e->value)));
       return;
     }
     for (std::size_t i = 0; i < tree().size(e->value); ++i) {
       const ValueId key = tree().key(e->value, i);
       if (!tree().isScalar(key)) {
         reader_.error(
-            key, fmt::format("expected a key name in materials, got {}", reader_.describe(key)));
+            key, fmt::format("expected a key name in {}, got {}", section, reader_.describe(key)));
         continue;
       }
-      add(EntityKind::MaterialEntity, static_cast<std::uint32_t>(i), tree().value(e->value, i), key,
-          key);
+      add(kind, static_cast<std::uint32_t>(i), tree().value(e->value, i), key, key);
     }
   }
 

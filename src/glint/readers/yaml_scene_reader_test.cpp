@@ -278,7 +278,10 @@ TEST(SceneParser, WrongTypesAtTheValue) {
                  "6 hexadecimal digits");
   expectOneError(
       std::string(kMinimal) + "materials: {m: {kd: {r: 1}}}\n", 3, 21,
-      "materials.m.kd: expected a number or a list of 3 numbers [r, g, b], got a mapping");
+      "materials.m.kd is missing required key 'type' (one of: checker, checker2d, noise, marble, "
+      "wood, image)");  // a mapping is a texture
+  expectOneError(std::string(kMinimal) + "materials: {m: {kd: [1, 2]}}\n", 3, 21,
+                 "materials.m.kd: expected a list of 3 numbers [r, g, b], got a list of 2 items");
   expectOneError(std::string(kMinimal) + "objects: {type: sphere}\n", 3, 10,
                  "objects: expected a list of objects, got a mapping");
   expectOneError(
@@ -815,6 +818,28 @@ TEST_F(IncludeFiles, ErrorsNameBothPlacesAndTheFileTheyAreIn) {
                                 "common/paints.yaml:3:13: materials.bad.kd must be >= 0, got -1"}));
 }
 
+TEST_F(IncludeFiles, IncludedTexturesJoinTheSceneAndAreNamedOnce) {
+  // A library of textures and the materials that use them; the scene uses both.
+  write("scene.yaml", std::string("include: common/library.yaml\n") + kCameraImage +
+                          "objects:\n"
+                          "  - {type: sphere, center: [0, 0, 0], radius: 1, material: tiles}\n"
+                          "  - {type: sphere, center: [2, 0, 0], radius: 1, "
+                          "material: {kd: squares}}\n");
+  write("common/library.yaml",
+        "textures:\n  squares: {type: checker, colors: [[1, 1, 1], [0, 0, 0]]}\n"
+        "materials:\n  tiles: {kd: squares}\n");
+  const LoadedScene s = loadScene(dir_ / "scene.yaml");
+  ASSERT_EQ(s.parts.primitives.size(), 2u);
+  for (const auto& primitive : s.parts.primitives) {
+    EXPECT_NE(s.parts.materials.at(primitive.materialIndex()).textures, kUntextured);
+  }
+  write("twice.yaml", std::string("include: common/library.yaml\n") + kCameraImage +
+                          "textures:\n  squares: {type: noise}\n");
+  EXPECT_EQ(errorsOf("twice.yaml"),
+            (std::vector<std::string>{"twice.yaml:4:3: duplicate texture 'squares': defined "
+                                      "twice (first at common/library.yaml:2:3)"}));
+}
+
 TEST_F(IncludeFiles, CyclesMissingFilesAndSceneKeysAreErrorsAtTheirPlace) {
   write("a.yaml", std::string("include: [b.yaml, missing.yaml]\n") + kCameraImage);
   write("b.yaml", "include: [a.yaml]\nmaterials: {m: {kd: 1}}\nobjects: []\n");
@@ -823,7 +848,7 @@ TEST_F(IncludeFiles, CyclesMissingFilesAndSceneKeysAreErrorsAtTheirPlace) {
                 "a.yaml:1:19: cannot include 'missing.yaml': No such file or directory",
                 "b.yaml:1:11: include cycle: a.yaml -> b.yaml -> a.yaml",
                 "b.yaml:3:1: 'objects' belongs in the scene file: an included file holds "
-                "materials and further includes only"}));
+                "textures, materials and further includes only"}));
   write("c.yaml", std::string("include: [list.yaml, broken.yaml, {a: 1}]\n") + kCameraImage);
   write("list.yaml", "- a\n");
   write("broken.yaml", "materials: {m: {kd: [1, 2}\n");

@@ -16,16 +16,57 @@ CameraSpec cameraSpecFor(const SceneParts& parts) {
   return spec;
 }
 
+// The factor a shadow ray keeps crossing a surface of `material`: kt, times the mean of kt's
+// texture (a shadow ray has no (u, v) to look one up at).
+Color shadowTransmission(const Material& material, const std::vector<Texture>& textures,
+                         const std::vector<MaterialTextures>& bindings) {
+  if (material.textures == kUntextured) return material.kt;
+  const TextureId kt = bindings[material.textures].kt;
+  return kt == kNoTexture ? material.kt : material.kt * meanOf(textures[kt]);
+}
+
+// Every material's texture bindings and texture ids must be in range.
+void checkTextures(const SceneParts& parts) {
+  for (std::size_t i = 0; i < parts.materials.size(); ++i) {
+    const std::uint32_t t = parts.materials[i].textures;
+    if (t != kUntextured && t >= parts.materialTextures.size()) {
+      throw std::invalid_argument("material " + std::to_string(i) + " uses texture binding " +
+                                  std::to_string(t) + ", but the scene has only " +
+                                  std::to_string(parts.materialTextures.size()));
+    }
+  }
+  for (const MaterialTextures& m : parts.materialTextures) {
+    for (const TextureId id : {m.kd, m.ks, m.kr, m.kt, m.ka, m.emission, m.normalMap, m.bumpMap}) {
+      if (id != kNoTexture && id >= parts.textures.size()) {
+        throw std::invalid_argument("texture " + std::to_string(id) +
+                                    " is used, but the scene has only " +
+                                    std::to_string(parts.textures.size()) + " textures");
+      }
+    }
+  }
+  for (const Texture& texture : parts.textures) {
+    const auto* image = std::get_if<ImageTexture>(&texture);
+    if (image != nullptr && image->image == nullptr) {
+      throw std::invalid_argument("an image texture has no image");
+    }
+  }
+  if (parts.environment.kind == BackgroundKind::Image && parts.environment.image == nullptr) {
+    throw std::invalid_argument("an image background has no image");
+  }
+}
+
 // Checks every material index and pairs each primitive and mesh with its material's kt, the factor
 // a shadow ray keeps per crossing.
-Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materials) {
+Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materials,
+                         const std::vector<Texture>& textures,
+                         const std::vector<MaterialTextures>& bindings) {
   const auto checkMaterial = [&](const char* what, std::size_t i, std::uint32_t material) {
     if (material >= materials.size()) {
       throw std::invalid_argument(std::string(what) + " " + std::to_string(i) + " uses material " +
                                   std::to_string(material) + ", but the scene has only " +
                                   std::to_string(materials.size()) + " materials");
     }
-    return materials[material].kt;
+    return shadowTransmission(materials[material], textures, bindings);
   };
   std::vector<Color> transmission;
   transmission.reserve(parts.primitives.size());
@@ -44,14 +85,17 @@ Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materia
 }  // namespace
 
 Scene::Scene(SceneParts parts)
-    : name_(std::move(parts.name)),
+    : name_((checkTextures(parts), std::move(parts.name))),
       materials_(std::move(parts.materials)),
+      textures_(std::move(parts.textures)),
+      materialTextures_(std::move(parts.materialTextures)),
       lights_(std::move(parts.lights)),
       ambient_(parts.ambient),
       background_(parts.background),
+      environment_(std::move(parts.environment)),
       camera_(cameraSpecFor(parts)),
       image_(std::move(parts.image)),
       render_(parts.render),
-      aggregate_(buildAggregate(parts, materials_)) {}
+      aggregate_(buildAggregate(parts, materials_, textures_, materialTextures_)) {}
 
 }  // namespace glint

@@ -11,8 +11,10 @@
 #include "glint/accel/aggregate.h"
 #include "glint/core/color.h"
 #include "glint/scene/camera.h"
+#include "glint/scene/environment.h"
 #include "glint/scene/light.h"
 #include "glint/scene/material.h"
+#include "glint/scene/texture.h"
 
 namespace glint {
 
@@ -56,11 +58,14 @@ struct SceneParts {
   std::vector<Primitive> primitives;
   std::vector<TriangleMesh> meshes;  // mesh material indices point into `materials`
   Acceleration acceleration = Acceleration::Bvh;
-  std::vector<Material> materials{Material{}};  // index 0: the default material
+  std::vector<Material> materials{Material{}};     // index 0: the default material
+  std::vector<Texture> textures;                   // MaterialTextures' TextureIds index these
+  std::vector<MaterialTextures> materialTextures;  // Material::textures index these
   std::vector<Light> lights;
-  Color ambient;      // Ia = ambient color × ambient intensity
-  Color background;   // linear; what a ray that misses returns
-  CameraSpec camera;  // imageWidth/imageHeight are overwritten from `image`
+  Color ambient;            // Ia = ambient color × ambient intensity
+  Color background;         // linear; what a ray that misses returns (environment.kind Uniform)
+  Environment environment;  // a gradient or an image instead of the one colour
+  CameraSpec camera;        // imageWidth/imageHeight are overwritten from `image`
   ImageSettings image;
   RenderSettings render;
 };
@@ -89,9 +94,18 @@ class Scene {
     return hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].emission()
                                : aggregate_.meshes()[hit.mesh].emission;
   }
+  const std::vector<Texture>& textures() const { return textures_; }
+  const std::vector<MaterialTextures>& materialTextures() const { return materialTextures_; }
+  // Whether any material or the background has a texture: the renderer then tracks ray
+  // differentials and evaluates textures; without, it never looks at them.
+  bool hasTextures() const { return !textures_.empty(); }
   const std::vector<Light>& lights() const { return lights_; }
   const Color& ambient() const { return ambient_; }
   const Color& background() const { return background_; }
+  const Environment& environment() const { return environment_; }
+  bool uniformBackground() const { return environment_.kind == BackgroundKind::Uniform; }
+  // What a ray leaving the scene along the unit direction d sees.
+  Color backgroundAlong(const Vec3& d) const { return environment_.along(d, background_); }
   const Camera& camera() const { return camera_; }
   const ImageSettings& image() const { return image_; }
   const RenderSettings& render() const { return render_; }
@@ -106,9 +120,12 @@ class Scene {
  private:
   std::string name_;
   std::vector<Material> materials_;
+  std::vector<Texture> textures_;
+  std::vector<MaterialTextures> materialTextures_;
   std::vector<Light> lights_;
   Color ambient_;
   Color background_;
+  Environment environment_;
   Camera camera_;
   ImageSettings image_;
   RenderSettings render_;

@@ -1,0 +1,182 @@
+// Texture evaluation and filtering: a 2×2 image's texels under nearest, bilinear and trilinear
+// lookups, mip level selection at known footprints, mip building, the solid checker, the uv
+// transform, Perlin noise, and the environment's equirectangular directions.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "glint/scene/environment.h"
+#include "glint/scene/mip_map.h"
+#include "glint/scene/texture.h"
+
+namespace glint {
+namespace {
+
+constexpr double kTol = 1e-6;
+
+// Rows from the top: top-left red, top-right green, bottom-left blue, bottom-right white.
+RgbImage twoByTwo() {
+  return RgbImage{2, 2, {1, 0, 0, 0, 1, 0, /* bottom row */ 0, 0, 1, 1, 1, 1}};
+}
+
+void expectColor(const Color& c, double r, double g, double b, double tol = kTol) {
+  EXPECT_NEAR(c.r, r, tol);
+  EXPECT_NEAR(c.g, g, tol);
+  EXPECT_NEAR(c.b, b, tol);
+}
+
+TEST(MipMap, NearestReturnsEachTexelOfATwoByTwoImage) {
+  const MipMap m(twoByTwo());
+  // (0, 0) is the image's bottom-left corner, (1, 1) its top-right.
+  expectColor(m.nearest({0.25, 0.75}), 1, 0, 0);
+  expectColor(m.nearest({0.75, 0.75}), 0, 1, 0);
+  expectColor(m.nearest({0.25, 0.25}), 0, 0, 1);
+  expectColor(m.nearest({0.75, 0.25}), 1, 1, 1);
+  expectColor(m.nearest({0.99, 0.01}), 1, 1, 1);
+  expectColor(m.nearest({1.25, -0.25}), 1, 0, 0);  // repeats: (0.25, 0.75)
+}
+
+TEST(MipMap, BilinearInterpolatesBetweenTexelCentres) {
+  const MipMap m(twoByTwo());
+  expectColor(m.bilinear(0, {0.25, 0.75}), 1, 0, 0);  // a texel centre: the texel itself
+  expectColor(m.bilinear(0, {0.75, 0.25}), 1, 1, 1);
+  // Halfway between the two top texels.
+  expectColor(m.bilinear(0, {0.5, 0.75}), 0.5, 0.5, 0);
+  // The centre: the mean of all four.
+  expectColor(m.bilinear(0, {0.5, 0.5}), 0.5, 0.5, 0.5);
+  // At the left edge, halfway to the wrapped right column.
+  expectColor(m.bilinear(0, {0, 0.75}), 0.5, 0.5, 0);
+}
+
+TEST(MipMap, TrilinearPicksTheLevelOfTheFootprint) {
+  const MipMap m(twoByTwo());
+  ASSERT_EQ(m.levels(), 2);
+  expectColor(m.texel(1, 0, 0), 0.5, 0.5, 0.5);
+  // A footprint of one texel (1/2 in st): level 0, the texel itself.
+  expectColor(m.trilinear({0.25, 0.75}, 0.5), 1, 0, 0);
+  // Smaller footprints stay at level 0.
+  expectColor(m.trilinear({0.25, 0.75}, 0.01), 1, 0, 0);
+  // The whole image: level 1, the mean.
+  expectColor(m.trilinear({0.25, 0.75}, 1), 0.5, 0.5, 0.5);
+  // Halfway in log2 between them: level 0.5, the blend.
+  expectColor(m.trilinear({0.25, 0.75}, std::sqrt(0.5)), 0.75, 0.25, 0.25);
+}
+
+TEST(MipMap, LevelAtAKnownFootprint) {
+  RgbImage big{256, 64, std::vector<float>(256 * 64 * 3, 0.5f)};
+  const MipMap m(std::move(big));
+  EXPECT_EQ(m.levels(), 9);  // 256×64, 128×32, ..., 1×1
+  EXPECT_EQ(m.width(2), 64);
+  EXPECT_EQ(m.height(2), 16);
+  EXPECT_EQ(m.height(7), 1);
+  // pbrt-v4: levels − 1 + log2(width): one texel of level 0 (1/256) is level 0; four, level 2.
+  EXPECT_NEAR(m.levelFor(1.0 / 256), 0, kTol);
+  EXPECT_NEAR(m.levelFor(4.0 / 256), 2, kTol);
+  EXPECT_NEAR(m.levelFor(1), 8, kTol);
+}
+
+TEST(MipMap, OddSizesAverageWithFractionalCoverage) {
+  // A 3×1 image → 1×1: every texel counts a third.
+  const MipMap m(RgbImage{3, 1, {0, 0, 0, 0.3f, 0.3f, 0.3f, 0.9f, 0.9f, 0.9f}});
+  ASSERT_EQ(m.levels(), 2);
+  expectColor(m.texel(1, 0, 0), 0.4, 0.4, 0.4);
+  EXPECT_EQ(m.memoryBytes(), MipMap::bytesFor(3, 1));
+}
+
+TEST(Texture, SolidCheckerAtCellCentres) {
+  const Texture t = CheckerTexture{{Color(0.1), Color(0.9)}, 0.5};
+  for (int i = -3; i <= 3; ++i) {
+    for (int j = -3; j <= 3; ++j) {
+      for (int k = -3; k <= 3; ++k) {
+        const Point3 centre{(i + 0.5) * 0.5, (j + 0.5) * 0.5, (k + 0.5) * 0.5};
+        const bool odd = ((i + j + k) % 2 + 2) % 2 == 1;
+        EXPECT_EQ(evaluate(t, {centre, {}, {}, {}}).r, odd ? 0.9 : 0.1)
+            << i << " " << j << " " << k;
+      }
+    }
+  }
+}
+
+TEST(Texture, Checker2dAppliesRepeatOffsetAndRotation) {
+  UvTransform transform;
+  transform.repeat = {4, 2};
+  const Texture t = Checker2dTexture{{Color(0), Color(1)}, transform};
+  EXPECT_EQ(evaluate(t, {{}, {0.1, 0.1}, {}, {}}).r, 0);
+  EXPECT_EQ(evaluate(t, {{}, {0.3, 0.1}, {}, {}}).r, 1);
+  EXPECT_EQ(evaluate(t, {{}, {0.3, 0.6}, {}, {}}).r, 0);
+  // Rotated by 90°: (u, v) ↦ (−v, u).
+  UvTransform rotated;
+  rotated.cosRotate = 0;
+  rotated.sinRotate = 1;
+  const Point2 p = rotated.apply({0.25, 0.5});
+  EXPECT_NEAR(p.x, -0.5, kTol);
+  EXPECT_NEAR(p.y, 0.25, kTol);
+}
+
+TEST(Texture, PerlinNoiseIsZeroOnTheLatticeAndBounded) {
+  EXPECT_EQ(perlinNoise({0, 0, 0}), 0);
+  EXPECT_EQ(perlinNoise({3, -7, 12}), 0);
+  for (int i = 0; i < 1000; ++i) {
+    const double n = perlinNoise({i * 0.173, i * 0.311, i * 0.0917});
+    EXPECT_LE(std::abs(n), 1.0);
+  }
+  // The marble, wood and noise patterns stay between their two colours.
+  for (const NoisePattern pattern :
+       {NoisePattern::Noise, NoisePattern::Marble, NoisePattern::Wood}) {
+    const Texture t = NoiseTexture{pattern, {Color(0.2), Color(0.6)}, 0.3, 2, 4};
+    for (int i = 0; i < 200; ++i) {
+      const double v = evaluate(t, {{i * 0.07, i * 0.05, -i * 0.03}, {}, {}, {}}).r;
+      EXPECT_GE(v, 0.2 - kTol);
+      EXPECT_LE(v, 0.6 + kTol);
+    }
+  }
+}
+
+TEST(Environment, EquirectangularDirections) {
+  // −z is the centre column, +y the top row, +x at u = 0.75.
+  const Point2 back = equirectangularUv({0, 0, -1});
+  EXPECT_NEAR(back.x, 0.5, kTol);
+  EXPECT_NEAR(back.y, 0.5, kTol);
+  EXPECT_NEAR(equirectangularUv({0, 1, 0}).y, 1, kTol);
+  EXPECT_NEAR(equirectangularUv({0, -1, 0}).y, 0, kTol);
+  EXPECT_NEAR(equirectangularUv({1, 0, 0}).x, 0.75, kTol);
+  EXPECT_NEAR(equirectangularUv({-1, 0, 0}).x, 0.25, kTol);
+}
+
+TEST(Environment, ImageAndRotationAndGradient) {
+  // 4×2: the top row red, green, blue, white from left to right; the bottom row black.
+  RgbImage image{4, 2, std::vector<float>(4 * 2 * 3, 0.0f)};
+  const float top[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+  for (int x = 0; x < 4; ++x) {
+    for (int c = 0; c < 3; ++c) image.pixels[static_cast<std::size_t>(3 * x + c)] = top[x][c];
+  }
+  Environment e;
+  e.kind = BackgroundKind::Image;
+  e.image = std::make_shared<const MipMap>(std::move(image));
+  e.intensity = 2;
+  // The centre of the top row's second texel (green): u = 0.375, v = 0.75.
+  const double r = std::sqrt(0.5);
+  expectColor(e.along({-0.5, r, -0.5}, Color()), 0, 2, 0);
+  // The centre of the top row's third texel (blue): u = 0.625.
+  expectColor(e.along({0.5, r, -0.5}, Color()), 0, 0, 2);
+  // Turned by +90° about +y (counter-clockwise seen from above), green moves to (−0.5, ·, +0.5).
+  e.cosRotate = 0;
+  e.sinRotate = 1;
+  expectColor(e.along({-0.5, r, 0.5}, Color()), 0, 2, 0);
+
+  Environment g;
+  g.kind = BackgroundKind::Gradient;
+  g.zenith = Color(0, 0, 1);
+  g.horizon = Color(1, 1, 1);
+  g.nadir = Color(0.2, 0.1, 0);
+  expectColor(g.along({0, 1, 0}, Color()), 0, 0, 1);
+  expectColor(g.along({1, 0, 0}, Color()), 1, 1, 1);
+  expectColor(g.along({0, -1, 0}, Color()), 0.2, 0.1, 0);
+  expectColor(g.along({r, r, 0}, Color()), 0.5, 0.5, 1);  // 45°: halfway in elevation
+  Environment uniform;
+  expectColor(uniform.along({0, 1, 0}, Color(0.3)), 0.3, 0.3, 0.3);
+}
+
+}  // namespace
+}  // namespace glint
