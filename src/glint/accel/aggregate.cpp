@@ -282,6 +282,11 @@ void validateMesh(const TriangleMesh& mesh, std::size_t m) {
                                 " normals for " + std::to_string(mesh.positions.size()) +
                                 " positions");
   }
+  if (!mesh.colors.empty() && mesh.colors.size() != mesh.positions.size()) {
+    throw std::invalid_argument(meshName(m) + " has " + std::to_string(mesh.colors.size()) +
+                                " colors for " + std::to_string(mesh.positions.size()) +
+                                " positions");
+  }
   const std::size_t positions = mesh.positions.size();
   const auto bad = std::find_if(mesh.indices.begin(), mesh.indices.end(),
                                 [positions](std::uint32_t i) { return i >= positions; });
@@ -448,15 +453,18 @@ void Aggregate::storeInLeafOrder(const std::vector<bvh::BuildItem>& items) {
     }
     std::vector<Point3> positions(vertices);
     std::vector<Normal3> normals(mesh.normals.empty() ? 0 : vertices);
+    std::vector<Color> colors(mesh.colors.empty() ? 0 : vertices);
     for (std::size_t old = 0; old < vertexOf.size(); ++old) {
       const std::uint32_t v = vertexOf[old];
       if (v == kUnused) continue;
       positions[v] = mesh.positions[old];
       if (!normals.empty()) normals[v] = mesh.normals[old];
+      if (!colors.empty()) colors[v] = mesh.colors[old];
     }
     mesh.indices = std::move(indices);
     mesh.positions = std::move(positions);
     mesh.normals = std::move(normals);
+    mesh.colors = std::move(colors);
   });
 }
 
@@ -464,7 +472,7 @@ std::size_t Aggregate::memoryBytes() const {
   std::size_t bytes = 0;
   for (const TriangleMesh& mesh : meshes_) {
     bytes += mesh.positions.capacity() * sizeof(Point3) +
-             mesh.normals.capacity() * sizeof(Normal3) +
+             mesh.normals.capacity() * sizeof(Normal3) + mesh.colors.capacity() * sizeof(Color) +
              mesh.indices.capacity() * sizeof(std::uint32_t);
   }
   bytes += primitives_.capacity() * sizeof(Primitive) + transmission_.capacity() * sizeof(Color) +
@@ -791,6 +799,22 @@ Color Aggregate::transmittanceBruteForce(const Ray& ray, double tMin, double tMa
     }
   }
   return result;
+}
+
+Color Aggregate::vertexColor(const Hit& hit) const {
+  const TriangleMesh& m = meshes_[hit.mesh];
+  const std::uint32_t* index = m.indices.data() + 3 * static_cast<std::size_t>(hit.triangle);
+  const Point3& p0 = m.positions[index[0]];
+  const Vec3 e1 = m.positions[index[1]] - p0;
+  const Vec3 e2 = m.positions[index[2]] - p0;
+  const Vec3 rel = hit.point - p0;
+  // Barycentric coordinates of the hit point from the sub-triangle areas (signed, along n),
+  // clamped against the rounding of a point on an edge.
+  const Vec3 n = cross(e1, e2);
+  const double area = dot(n, n);
+  const double b1 = std::clamp(dot(cross(rel, e2), n) / area, 0.0, 1.0);
+  const double b2 = std::clamp(dot(cross(e1, rel), n) / area, 0.0, 1.0 - b1);
+  return m.colors[index[0]] * (1 - b1 - b2) + m.colors[index[1]] * b1 + m.colors[index[2]] * b2;
 }
 
 }  // namespace glint

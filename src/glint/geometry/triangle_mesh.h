@@ -18,7 +18,10 @@ struct TriangleMesh {
   std::vector<Point3> positions;       // world space, scene units (any transform already applied)
   std::vector<Normal3> normals;        // per vertex, unit, world space; empty: flat shading
   std::vector<std::uint32_t> indices;  // three per triangle, into positions (and normals)
-  std::uint32_t materialIndex = 0;     // into SceneParts::materials
+  // Per vertex, linear; empty: none. Interpolated over each triangle, they multiply the material's
+  // kd and ka at the hit (Tachyon's per-vertex colours, VMD's coloured surfaces).
+  std::vector<Color> colors;
+  std::uint32_t materialIndex = 0;  // into SceneParts::materials
   Color emission;
 
   std::size_t triangleCount() const { return indices.size() / 3; }

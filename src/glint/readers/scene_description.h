@@ -27,6 +27,7 @@ enum class EntityKind : std::uint8_t {
   MaterialEntity,  // a named material of `materials`
   ObjectEntity,    // an entry of `objects`; its `type` names its factory
   LightEntity,     // an entry of `lights`; its `type` names its factory
+  FogEntity,       // distance fog
 };
 
 // One text a scene was read from.

@@ -41,7 +41,7 @@ class TopLevel {
 
   void read(ValueId root) {
     ParameterDictionary top(reader_, root, {"at the top level", "", "the scene"});
-    top.declare({"name", "background", "ambient", "camera", "image", "render", "materials",
+    top.declare({"name", "background", "ambient", "fog", "camera", "image", "render", "materials",
                  "objects", "lights"});
     for (const char* key : {"camera", "image"}) {
       if (!top.has(key)) {
@@ -51,6 +51,7 @@ class TopLevel {
     if (const auto name = top.text("name")) scene_.name = name->where;
     section(top, "background", EntityKind::BackgroundEntity);
     section(top, "ambient", EntityKind::AmbientEntity);
+    section(top, "fog", EntityKind::FogEntity);
     section(top, "camera", EntityKind::CameraEntity);
     section(top, "image", EntityKind::ImageEntity);
     section(top, "render", EntityKind::RenderEntity);

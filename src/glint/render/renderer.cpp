@@ -71,6 +71,9 @@ enum class SecondaryKind { Reflection, Refraction };
 
 Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split,
             const SampleStream& stream);
+Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double t, int depth);
+Color shadeHit(const TraceContext& ctx, const Ray& ray, const Hit& hit, int depth,
+               const Color& weight, bool split, const SampleStream& stream);
 
 // The position of a point or spot light; false for a directional light (at infinity).
 bool lightPosition(const Light& light, Point3& position) {
@@ -277,10 +280,39 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   // Aggregate::intersect sets every field of a hit it reports; a miss reads nothing.
   std::optional<Hit> deepHit;  // constructed only past the preallocated depths
   Hit& hit = depth < ctx.hitCount ? ctx.hits[depth] : deepHit.emplace();
-  if (!ctx.scene.intersect(ray, kInfinity, hit)) return ctx.scene.background();
+  if (!ctx.scene.intersect(ray, kInfinity, hit)) {
+    const std::optional<Fog>& fog = ctx.scene.fog();
+    return fog && fog->distance == FogDistance::Ray ? fog->color : ctx.scene.background();
+  }
+  const Color color = shadeHit(ctx, ray, hit, depth, weight, split, stream);
+  return ctx.scene.fog() ? fogged(ctx, color, ray, hit.t, depth) : color;
+}
+
+// What a ray sees at its hit, seen through the fog over the distance t it travelled (Fog::distance
+// says how camera rays measure it).
+Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double t, int depth) {
+  const Fog& fog = *ctx.scene.fog();
+  const bool viewDepth = fog.distance == FogDistance::Depth && depth == 0;
+  return fog.apply(color, viewDepth ? t * dot(ray.direction, ctx.scene.camera().toward()) : t);
+}
+
+// The colour at a hit, unfogged: emission, ambient, direct light, and the reflected and transmitted
+// rays (DESIGN.md §3).
+Color shadeHit(const TraceContext& ctx, const Ray& ray, const Hit& hit, int depth,
+               const Color& weight, bool split, const SampleStream& stream) {
   const int hitDepth = depth + 1;
 
-  const Material& material = ctx.scene.materialOf(hit);
+  // A mesh with vertex colours tints kd and ka at the hit (TriangleMesh::colors).
+  const Material* hitMaterial = &ctx.scene.materialOf(hit);
+  std::optional<Material> tinted;  // constructed only for such a mesh
+  if (hit.mesh != kNoMesh && !ctx.scene.meshes()[hit.mesh].colors.empty()) {
+    const Color tint = ctx.scene.aggregate().vertexColor(hit);
+    tinted.emplace(*hitMaterial);
+    tinted->kd *= tint;
+    tinted->ka *= tint;
+    hitMaterial = &*tinted;
+  }
+  const Material& material = *hitMaterial;
   // The reprojected hit point and its error bound: ray.at(hit.t) would carry rounding error that
   // grows with the ray's origin and length, which no offset proportional to |p| covers.
   const Point3& p = hit.point;

@@ -49,6 +49,7 @@ Scene::Scene(SceneParts parts)
       lights_(std::move(parts.lights)),
       ambient_(parts.ambient),
       background_(parts.background),
+      fog_(parts.fog),
       camera_(cameraSpecFor(parts)),
       image_(std::move(parts.image)),
       render_(parts.render),

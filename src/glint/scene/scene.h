@@ -11,6 +11,7 @@
 #include "glint/accel/aggregate.h"
 #include "glint/core/color.h"
 #include "glint/scene/camera.h"
+#include "glint/scene/fog.h"
 #include "glint/scene/light.h"
 #include "glint/scene/material.h"
 
@@ -58,9 +59,10 @@ struct SceneParts {
   Acceleration acceleration = Acceleration::Bvh;
   std::vector<Material> materials{Material{}};  // index 0: the default material
   std::vector<Light> lights;
-  Color ambient;      // Ia = ambient color × ambient intensity
-  Color background;   // linear; what a ray that misses returns
-  CameraSpec camera;  // imageWidth/imageHeight are overwritten from `image`
+  Color ambient;           // Ia = ambient color × ambient intensity
+  Color background;        // linear; what a ray that misses returns
+  std::optional<Fog> fog;  // none by default
+  CameraSpec camera;       // imageWidth/imageHeight are overwritten from `image`
   ImageSettings image;
   RenderSettings render;
 };
@@ -92,6 +94,7 @@ class Scene {
   const std::vector<Light>& lights() const { return lights_; }
   const Color& ambient() const { return ambient_; }
   const Color& background() const { return background_; }
+  const std::optional<Fog>& fog() const { return fog_; }
   const Camera& camera() const { return camera_; }
   const ImageSettings& image() const { return image_; }
   const RenderSettings& render() const { return render_; }
@@ -109,6 +112,7 @@ class Scene {
   std::vector<Light> lights_;
   Color ambient_;
   Color background_;
+  std::optional<Fog> fog_;
   Camera camera_;
   ImageSettings image_;
   RenderSettings render_;
