@@ -1,11 +1,13 @@
 #include "glint/factories/scene_loader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "glint/factories/scene_builder.h"
+#include "glint/readers/nff_reader.h"
 #include "glint/readers/yaml_scene_reader.h"
 
 namespace glint {
@@ -17,12 +19,15 @@ bool before(const Diagnostic& a, const Diagnostic& b) {
   return a.where.column < b.where.column;
 }
 
-LoadedScene build(ParseResult parsed, const LoadOptions& options) {
+LoadedScene build(const ParseResult& parsedScene, const LoadOptions& options) {
+  ParseResult parsed;
+  parsed.diagnostics = parsedScene.diagnostics;
+  const SceneDescription& description = parsedScene.description;
   BuildOptions buildOptions;
   buildOptions.imageMemoryBudget = options.memoryBudget;
   buildOptions.overrides = options.overrides;
   buildOptions.cancel = options.cancel;
-  BuildResult built = buildScene(parsed.description, buildOptions);
+  BuildResult built = buildScene(description, buildOptions);
 
   std::vector<Diagnostic> errors;
   std::vector<Diagnostic> warnings;
@@ -35,7 +40,7 @@ LoadedScene build(ParseResult parsed, const LoadOptions& options) {
   std::stable_sort(errors.begin(), errors.end(), before);
   std::stable_sort(warnings.begin(), warnings.end(), before);
   if (!errors.empty()) throw SceneError(std::move(errors));
-  const SourceFile& scene = *parsed.description.files.at(0);
+  const SourceFile& scene = *description.files.at(0);
   return LoadedScene{std::move(built.parts), std::move(warnings), scene.bytes, scene.fnv1a};
 }
 
@@ -47,8 +52,19 @@ LoadedScene loadSceneFromString(std::string_view text, const std::string& displa
   return build(parseScene(text, displayName, baseDirectory, options.cancel), options);
 }
 
+LoadedScene buildDescribedScene(const ParseResult& parsed, const LoadOptions& options) {
+  return build(parsed, options);
+}
+
+ParseResult describeSceneFile(const std::filesystem::path& file, const LoadOptions& options) {
+  std::string extension = file.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".nff") return readNffFile(file, file.string(), options.cancel);
+  return readSceneFile(file, file.string(), options.cancel);
+}
+
 LoadedScene loadScene(const std::filesystem::path& file, const LoadOptions& options) {
-  return build(readSceneFile(file, file.string(), options.cancel), options);
+  return build(describeSceneFile(file, options), options);
 }
 
 }  // namespace glint
