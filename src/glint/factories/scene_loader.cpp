@@ -8,6 +8,7 @@
 
 #include "glint/factories/scene_builder.h"
 #include "glint/readers/nff_reader.h"
+#include "glint/readers/tachyon_reader.h"
 #include "glint/readers/yaml_scene_reader.h"
 
 namespace glint {
@@ -60,6 +61,7 @@ ParseResult describeSceneFile(const std::filesystem::path& file, const LoadOptio
   std::string extension = file.extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (extension == ".nff") return readNffFile(file, file.string(), options.cancel);
+  if (extension == ".dat") return readTachyonFile(file, file.string(), options.cancel);
   return readSceneFile(file, file.string(), options.cancel);
 }
 

@@ -38,7 +38,7 @@ struct LoadOptions {
 };
 
 // The scene file's entities, read by the reader its extension picks (DESIGN.md §13): .nff (NFF),
-// anything else YAML (.yaml .yml .json). Throws as loadScene does.
+// .dat (Tachyon), anything else YAML (.yaml .yml .json). Throws as loadScene does.
 ParseResult describeSceneFile(const std::filesystem::path& file, const LoadOptions& options = {});
 
 // Builds what a reader described: throws SceneError with the reader's and the factories' errors
