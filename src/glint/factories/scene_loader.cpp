@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "glint/factories/quick_look.h"
 #include "glint/factories/scene_builder.h"
 #include "glint/readers/nff_reader.h"
 #include "glint/readers/tachyon_reader.h"
@@ -62,6 +63,7 @@ ParseResult describeSceneFile(const std::filesystem::path& file, const LoadOptio
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (extension == ".nff") return readNffFile(file, file.string(), options.cancel);
   if (extension == ".dat") return readTachyonFile(file, file.string(), options.cancel);
+  if (isQuickLookFile(file)) return describeQuickLook(file, options);
   return readSceneFile(file, file.string(), options.cancel);
 }
 

@@ -38,7 +38,8 @@ struct LoadOptions {
 };
 
 // The scene file's entities, read by the reader its extension picks (DESIGN.md §13): .nff (NFF),
-// .dat (Tachyon), anything else YAML (.yaml .yml .json). Throws as loadScene does.
+// .dat (Tachyon), a mesh file's extension (.obj .ply .stl .gltf .glb: a quick look at the model,
+// factories/quick_look.h), anything else YAML (.yaml .yml .json). Throws as loadScene does.
 ParseResult describeSceneFile(const std::filesystem::path& file, const LoadOptions& options = {});
 
 // Builds what a reader described: throws SceneError with the reader's and the factories' errors
