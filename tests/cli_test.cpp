@@ -222,6 +222,15 @@ const std::vector<BrokenScene> kBrokenScenes{
     {"adaptive_max_below_samples.yaml", "10:28", {"max_samples", "image.samples"}},
     {"adaptive_threshold_zero.yaml", "9:43", {"threshold"}},
     {"aperture_without_focus.yaml", "6:13", {"focus_distance", "look_at"}},
+    // Other renderers' formats (DESIGN.md §13), read by their extension.
+    {"nff_unknown_statement.nff", "11:1", {"unknown NFF statement 'sp'", "did you mean 's'"}},
+    {"nff_not_a_number.nff", "10:7", {"expected a number", "'zero'"}},
+    {"nff_zero_radius.nff", "11:9", {"sphere.radius must be > 0"}},
+    {"dat_unsupported_statement.dat",
+     "7:1",
+     {"SPHEREARRAY", "nearest supported statement is SPHERE"}},
+    {"dat_undefined_texture.dat", "4:27", {"undefined texture 'Carbon'"}},
+    {"dat_texfunc_checker.dat", "6:11", {"TEXFUNC 1", "not supported yet"}},
 };
 
 TEST_F(Cli, BrokenScenesExitTwoNamingFileLineAndColumn) {
@@ -246,6 +255,35 @@ TEST_F(Cli, EveryBrokenFileIsInTheTable) {
   EXPECT_EQ(listed.size(), kBrokenScenes.size()) << "a file is listed twice";
   EXPECT_GE(listed.size(), 25u);
   EXPECT_EQ(filesIn(kBroken), listed);
+}
+
+TEST_F(Cli, ConvertWritesAYamlSceneThatRendersTheSameBytes) {
+  const std::string scene = (fs::path(GLINT_SOURCE_DIR) / "scenes" / "spd-balls.nff").string();
+  RunResult r = run({"convert", scene, "-o", "balls.yaml"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "wrote balls.yaml (")) << r.out;
+  r = run({"render", scene, "--width", "96", "-o", "nff.ppm", "--quiet"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = run({"render", "balls.yaml", "--width", "96", "-o", "yaml.ppm", "--quiet"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(readFile(work_ / "nff.ppm"), readFile(work_ / "yaml.ppm"));
+  // A wrong output name, a broken scene: exit 2 and nothing written.
+  fs::remove(work_ / "balls.yaml");
+  r = run({"convert", scene, "-o", "balls.png"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "name it .yaml")) << r.err;
+  r = run({"convert", (kBroken / "nff_zero_radius.nff").string(), "-o", "zero.yaml"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "nff_zero_radius.nff:11:9:")) << r.err;
+  EXPECT_FALSE(fs::exists(work_ / "zero.yaml"));
+}
+
+TEST_F(Cli, AMeshFileRendersAsAQuickLook) {
+  const std::string mesh =
+      (fs::path(GLINT_SOURCE_DIR) / "scenes" / "meshes" / "torus_knot.obj").string();
+  const RunResult r = run({"render", mesh, "--width", "80", "-o", "look.png", "--quiet"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(pngSize(work_ / "look.png"), std::make_pair(80u, 60u));
 }
 
 TEST_F(Cli, EveryErrorOfAFileIsReported) {
