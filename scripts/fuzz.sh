@@ -5,13 +5,13 @@
 #   scripts/fuzz.sh [SECONDS | --total SECONDS] [--only NAME]... [-- LIBFUZZER_FLAGS...]
 #
 # SECONDS per fuzz target, default 60; --total SECONDS shares that time among the targets (CI).
-# --only NAME runs that target only (scene_loader, mesh_obj, mesh_ply, mesh_stl, mesh_gltf,
-# image_header, image_decode, mesh_texture).
+# --only NAME runs that target only (scene_loader, nff, tachyon, mesh_obj, mesh_ply, mesh_stl,
+# mesh_gltf, image_header, image_decode, mesh_texture).
 # Longer runs: `scripts/fuzz.sh 3600`; on both cores: `scripts/fuzz.sh 3600 -- -fork=2`.
 # The working corpus BUILD/corpus/NAME/ persists between runs (it grows), seeded from
-# fuzz/corpus/NAME/ and, for the scene loader, scenes/*.yaml. A finding (crash, sanitizer report,
-# uncaught exception, broken loader promise, input slower than FUZZ_TIMEOUT seconds, more than
-# FUZZ_RSS_MB MiB) stops that target and makes this script fail; the input is saved under
+# fuzz/corpus/NAME/ and scenes/ (scene_loader: *.yaml, nff: *.nff, tachyon: *.dat). A finding
+# (crash, sanitizer report, uncaught exception, broken loader promise, input slower than
+# FUZZ_TIMEOUT seconds, more than FUZZ_RSS_MB MiB) stops that target and makes this script fail; the input is saved under
 # BUILD/artifacts/NAME/. Reproduce with `BUILD/fuzz/NAME_fuzz FILE`, then add the (fixed) input
 # to fuzz/corpus/NAME/ as a regression. BUILD is build-fuzz, or FUZZ_BUILD_DIR.
 set -euo pipefail
@@ -19,7 +19,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
 
-usage() { sed -n '2,19s/^# \{0,1\}//p' "${BASH_SOURCE[0]}" >&2; }
+usage() { sed -n '2,20s/^# \{0,1\}//p' "${BASH_SOURCE[0]}" >&2; }
 
 seconds=60
 total=0
@@ -101,11 +101,15 @@ for fuzzer in "${fuzzers[@]}"; do
   if [[ -d "fuzz/corpus/$name" ]]; then
     find "fuzz/corpus/$name" -maxdepth 1 -type f -exec cp -f {} "$corpus"/ \;
   fi
-  if [[ "$name" == scene_loader ]]; then
-    for scene in scenes/*.yaml; do
-      [[ -f "$scene" ]] && cp -f "$scene" "$corpus/scenes-$(basename "$scene")"
-    done
-  fi
+  seeds=()
+  case "$name" in
+    scene_loader) seeds=(scenes/*.yaml) ;;
+    nff) seeds=(scenes/*.nff) ;;
+    tachyon) seeds=(scenes/*.dat) ;;
+  esac
+  for scene in "${seeds[@]}"; do
+    [[ -f "$scene" ]] && cp -f "$scene" "$corpus/scenes-$(basename "$scene")"
+  done
   dict=()
   [[ -f "fuzz/$name.dict" ]] && dict=("-dict=fuzz/$name.dict")
 

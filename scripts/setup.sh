@@ -30,8 +30,9 @@ PACKAGES=(
 )
 # clang with its compiler-rt (libFuzzer, ASan, UBSan runtimes) for the fuzz targets.
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
-# The benchmarks' references: Embree 3 (linked by bench/ only) and the Tachyon and POV-Ray renderers.
-BENCH_PACKAGES=(libembree-dev libbenchmark-dev tachyon povray)
+# The benchmarks' references: Embree 3 (linked by bench/ only), the Tachyon and POV-Ray renderers;
+# python3 for bench/spd_bench.sh's NFF-to-Tachyon converter and image comparison.
+BENCH_PACKAGES=(libembree-dev libbenchmark-dev tachyon povray python3)
 
 log() { printf 'setup: %s\n' "$*" >&2; }
 die() {

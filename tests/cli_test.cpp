@@ -226,6 +226,17 @@ const std::vector<BrokenScene> kBrokenScenes{
     {"unknown_texture_type.yaml", "10:18", {"chequer", "checker2d"}},
     {"missing_texture_file.yaml", "10:88", {"nowhere.png", "no such file"}},
     {"unknown_background_type.yaml", "9:21", {"skybox", "gradient or image"}},
+    // Other renderers' formats (DESIGN.md §13), read by their extension.
+    {"nff_unknown_statement.nff", "11:1", {"unknown NFF statement 'sp'", "did you mean 's'"}},
+    {"nff_not_a_number.nff", "10:7", {"expected a number", "'zero'"}},
+    {"nff_zero_radius.nff", "11:9", {"sphere.radius must be > 0"}},
+    {"dat_unsupported_statement.dat",
+     "7:1",
+     {"SPHEREARRAY", "nearest supported statement is SPHERE"}},
+    {"dat_undefined_texture.dat", "4:27", {"undefined texture 'Carbon'"}},
+    {"dat_texfunc_grit.dat",
+     "6:11",
+     {"TEXFUNC 2 (grit) is not supported by glint", "1 (3D checker)"}},
 };
 
 TEST_F(Cli, BrokenScenesExitTwoNamingFileLineAndColumn) {
@@ -250,6 +261,35 @@ TEST_F(Cli, EveryBrokenFileIsInTheTable) {
   EXPECT_EQ(listed.size(), kBrokenScenes.size()) << "a file is listed twice";
   EXPECT_GE(listed.size(), 25u);
   EXPECT_EQ(filesIn(kBroken), listed);
+}
+
+TEST_F(Cli, ConvertWritesAYamlSceneThatRendersTheSameBytes) {
+  const std::string scene = (fs::path(GLINT_SOURCE_DIR) / "scenes" / "spd-balls.nff").string();
+  RunResult r = run({"convert", scene, "-o", "balls.yaml"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "wrote balls.yaml (")) << r.out;
+  r = run({"render", scene, "--width", "96", "-o", "nff.ppm", "--quiet"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = run({"render", "balls.yaml", "--width", "96", "-o", "yaml.ppm", "--quiet"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(readFile(work_ / "nff.ppm"), readFile(work_ / "yaml.ppm"));
+  // A wrong output name, a broken scene: exit 2 and nothing written.
+  fs::remove(work_ / "balls.yaml");
+  r = run({"convert", scene, "-o", "balls.png"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "name it .yaml")) << r.err;
+  r = run({"convert", (kBroken / "nff_zero_radius.nff").string(), "-o", "zero.yaml"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "nff_zero_radius.nff:11:9:")) << r.err;
+  EXPECT_FALSE(fs::exists(work_ / "zero.yaml"));
+}
+
+TEST_F(Cli, AMeshFileRendersAsAQuickLook) {
+  const std::string mesh =
+      (fs::path(GLINT_SOURCE_DIR) / "scenes" / "meshes" / "torus_knot.obj").string();
+  const RunResult r = run({"render", mesh, "--width", "80", "-o", "look.png", "--quiet"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(pngSize(work_ / "look.png"), std::make_pair(80u, 60u));
 }
 
 TEST_F(Cli, EveryErrorOfAFileIsReported) {

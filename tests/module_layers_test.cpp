@@ -2,7 +2,8 @@
 // `#include "glint/<module>/..."` lines and checks each against the modules it may use:
 //   core ← geometry ← accel ← scene ← render;  readers (scene files as entities) use core only;
 //   mesh uses readers, scene and below; image (files of pictures) uses render's Film and below;
-//   factories turn entities into scene parts; job runs renders; cli only turns arguments into jobs.
+//   factories turn entities into scene parts; writers write scene descriptions (readers' entities)
+//   as YAML; job runs renders and conversions; cli only turns arguments into jobs.
 // Tests (*_test.cpp) may use anything.
 #include <gtest/gtest.h>
 
@@ -29,12 +30,13 @@ const std::map<std::string, std::set<std::string>>& allowedModules() {
       {"image", {"core", "geometry", "accel", "scene", "render", "image"}},
       {"factories",
        {"core", "geometry", "accel", "scene", "readers", "mesh", "image", "factories"}},
+      {"writers", {"core", "readers", "writers"}},
       {"job",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
-        "job"}},
+        "writers", "job"}},
       {"cli",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
-        "job", "cli"}},
+        "writers", "job", "cli"}},
   };
   return allowed;
 }

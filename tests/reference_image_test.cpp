@@ -1,4 +1,5 @@
-// Reference-image tests: every scene in scenes/ rendered small by the glint command and compared
+// Reference-image tests: every scene in scenes/ (glint's YAML, and the NFF and Tachyon scenes of
+// other renderers) rendered small by the glint command and compared
 // with the checked-in tests/references/<scene>.png. scripts/regenerate-references.sh rewrites the
 // references — only on purpose, after looking at the new images.
 //
@@ -26,10 +27,15 @@ constexpr double kMaxMeanAbsoluteDifference = 0.5;
 constexpr int kLargeDifference = 8;
 constexpr double kMaxFractionLarge = 0.005;
 
+// Scene files by name with their extension; the reference image is named after the stem.
 std::vector<std::string> sceneNames() {
   std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(fs::path(GLINT_SOURCE_DIR) / "scenes"))
-    if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
+  for (const auto& entry : fs::directory_iterator(fs::path(GLINT_SOURCE_DIR) / "scenes")) {
+    const fs::path& path = entry.path();
+    if (path.extension() == ".yaml" || path.extension() == ".nff" || path.extension() == ".dat") {
+      names.push_back(path.filename().string());
+    }
+  }
   std::sort(names.begin(), names.end());
   return names;
 }
@@ -37,8 +43,8 @@ std::vector<std::string> sceneNames() {
 class ReferenceImage : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ReferenceImage, MatchesCheckedInReference) {
-  const std::string name = GetParam();
-  const fs::path scene = fs::path(GLINT_SOURCE_DIR) / "scenes" / (name + ".yaml");
+  const fs::path scene = fs::path(GLINT_SOURCE_DIR) / "scenes" / GetParam();
+  const std::string name = scene.stem().string();
   const fs::path reference = fs::path(GLINT_SOURCE_DIR) / "tests" / "references" / (name + ".png");
   ASSERT_TRUE(fs::exists(reference))
       << reference << " is missing: run scripts/regenerate-references.sh and look at the result";
@@ -76,7 +82,7 @@ TEST_P(ReferenceImage, MatchesCheckedInReference) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, ReferenceImage, ::testing::ValuesIn(sceneNames()),
                          [](const ::testing::TestParamInfo<std::string>& paramInfo) {
-                           std::string id = paramInfo.param;
+                           std::string id = fs::path(paramInfo.param).stem().string();
                            std::replace(id.begin(), id.end(), '-', '_');
                            return id;
                          });

@@ -283,7 +283,8 @@ void validateMesh(const TriangleMesh& mesh, std::size_t m) {
                                 " positions");
   }
   for (const auto& [what, count] :
-       {std::pair{"uvs", mesh.uvs.size()}, std::pair{"tangents", mesh.tangents.size()}}) {
+       {std::pair{"uvs", mesh.uvs.size()}, std::pair{"tangents", mesh.tangents.size()},
+        std::pair{"colors", mesh.colors.size()}}) {
     if (count != 0 && count != mesh.positions.size()) {
       throw std::invalid_argument(meshName(m) + " has " + std::to_string(count) + " " + what +
                                   " for " + std::to_string(mesh.positions.size()) + " positions");
@@ -457,6 +458,7 @@ void Aggregate::storeInLeafOrder(const std::vector<bvh::BuildItem>& items) {
     std::vector<Normal3> normals(mesh.normals.empty() ? 0 : vertices);
     std::vector<Point2> uvs(mesh.uvs.empty() ? 0 : vertices);
     std::vector<VertexTangent> tangents(mesh.tangents.empty() ? 0 : vertices);
+    std::vector<Color> colors(mesh.colors.empty() ? 0 : vertices);
     for (std::size_t old = 0; old < vertexOf.size(); ++old) {
       const std::uint32_t v = vertexOf[old];
       if (v == kUnused) continue;
@@ -464,12 +466,14 @@ void Aggregate::storeInLeafOrder(const std::vector<bvh::BuildItem>& items) {
       if (!normals.empty()) normals[v] = mesh.normals[old];
       if (!uvs.empty()) uvs[v] = mesh.uvs[old];
       if (!tangents.empty()) tangents[v] = mesh.tangents[old];
+      if (!colors.empty()) colors[v] = mesh.colors[old];
     }
     mesh.indices = std::move(indices);
     mesh.positions = std::move(positions);
     mesh.normals = std::move(normals);
     mesh.uvs = std::move(uvs);
     mesh.tangents = std::move(tangents);
+    mesh.colors = std::move(colors);
   });
 }
 
@@ -479,7 +483,7 @@ std::size_t Aggregate::memoryBytes() const {
     bytes +=
         mesh.positions.capacity() * sizeof(Point3) + mesh.normals.capacity() * sizeof(Normal3) +
         mesh.indices.capacity() * sizeof(std::uint32_t) + mesh.uvs.capacity() * sizeof(Point2) +
-        mesh.tangents.capacity() * sizeof(VertexTangent);
+        mesh.tangents.capacity() * sizeof(VertexTangent) + mesh.colors.capacity() * sizeof(Color);
   }
   bytes += primitives_.capacity() * sizeof(Primitive) + transmission_.capacity() * sizeof(Color) +
            meshTransmission_.capacity() * sizeof(Color) +
@@ -805,6 +809,22 @@ Color Aggregate::transmittanceBruteForce(const Ray& ray, double tMin, double tMa
     }
   }
   return result;
+}
+
+Color Aggregate::vertexColor(const Hit& hit) const {
+  const TriangleMesh& m = meshes_[hit.mesh];
+  const std::uint32_t* index = m.indices.data() + 3 * static_cast<std::size_t>(hit.triangle);
+  const Point3& p0 = m.positions[index[0]];
+  const Vec3 e1 = m.positions[index[1]] - p0;
+  const Vec3 e2 = m.positions[index[2]] - p0;
+  const Vec3 rel = hit.point - p0;
+  // Barycentric coordinates of the hit point from the sub-triangle areas (signed, along n),
+  // clamped against the rounding of a point on an edge.
+  const Vec3 n = cross(e1, e2);
+  const double area = dot(n, n);
+  const double b1 = std::clamp(dot(cross(rel, e2), n) / area, 0.0, 1.0);
+  const double b2 = std::clamp(dot(cross(e1, rel), n) / area, 0.0, 1.0 - b1);
+  return m.colors[index[0]] * (1 - b1 - b2) + m.colors[index[1]] * b1 + m.colors[index[2]] * b2;
 }
 
 }  // namespace glint

@@ -58,6 +58,10 @@ class Aggregate {
   // Product of kt over every surface crossing in (tMin, tMax); stops early once it is black.
   Color transmittance(const Ray& ray, double tMin, double tMax) const;
 
+  // The vertex colour at a hit on a mesh that has colors (TriangleMesh::colors), interpolated
+  // barycentrically at the hit point.
+  Color vertexColor(const Hit& hit) const;
+
   const std::vector<Primitive>& primitives() const { return primitives_; }
   // The meshes as stored. With Acceleration::Bvh each mesh's triangles and vertices are renumbered
   // into the tree's leaf order and its degenerate triangles and unused vertices are left out (same

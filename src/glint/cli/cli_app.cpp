@@ -29,6 +29,7 @@
 #include "glint/job/job_error.h"
 #include "glint/job/render_job.h"
 #include "glint/job/scene_check.h"
+#include "glint/job/scene_convert.h"
 #include "glint/readers/diagnostics.h"
 #include "glint/render/film.h"
 #include "glint/render/renderer.h"
@@ -320,6 +321,22 @@ int runCheck(const std::string& file) {
   return kExitSuccess;
 }
 
+int runConvert(const std::string& file, const std::string& output) {
+  ConvertResult result;
+  try {
+    result = convertScene(ConvertSpec{file, output, nullptr});
+  } catch (const JobError& error) {
+    return reportJobError(error, file);
+  }
+  printDiagnostics(result.warnings);
+  std::string files;
+  for (const auto& mesh : result.meshFiles) files += ", " + mesh.string();
+  emit(stdout,
+       fmt::format("wrote {} ({} objects, {} lights){}\n", result.output.string(), result.objects,
+                   result.lights, files.empty() ? "" : " and its meshes " + files.substr(2)));
+  return kExitSuccess;
+}
+
 // The render command's arguments as a job: every value checked as far as possible without the
 // scene. `--seed` is not named in refusals: it changes no size.
 RenderJobSpec parseRequest(const RenderArgs& args) {
@@ -438,7 +455,7 @@ int runCommandLine(int argc, char** argv) {
 
   RenderArgs args;
   CLI::App* render = app.add_subcommand("render", "Render a scene file to an image");
-  render->add_option("SCENE", args.scene, "Scene file (YAML or JSON)")
+  render->add_option("SCENE", args.scene, "Scene file (YAML, JSON, .nff, .dat, or a mesh file)")
       ->required()
       ->type_name("FILE");
   render
@@ -492,7 +509,21 @@ int runCommandLine(int argc, char** argv) {
   std::string checkFile;
   CLI::App* check =
       app.add_subcommand("check", "Parse and build a scene, print a summary; writes nothing");
-  check->add_option("SCENE", checkFile, "Scene file (YAML or JSON)")->required()->type_name("FILE");
+  check->add_option("SCENE", checkFile, "Scene file (YAML, JSON, .nff, .dat, or a mesh file)")
+      ->required()
+      ->type_name("FILE");
+
+  std::string convertFile, convertOutput;
+  CLI::App* convert = app.add_subcommand(
+      "convert", "Write any scene glint reads (NFF, Tachyon .dat, a mesh) as a glint YAML scene");
+  convert->add_option("SCENE", convertFile, "Scene file (YAML, .nff, .dat, or a mesh file)")
+      ->required()
+      ->type_name("FILE");
+  convert
+      ->add_option("-o,--output", convertOutput,
+                   "The YAML scene to write (large meshes go beside it as PLY files); default: the "
+                   "scene's name with .yaml, in the current folder")
+      ->type_name("OUT");
 
   // Set after the subcommands exist: CLI11 copies a parent's footer into subcommands made later.
   const std::string exitStatus =
@@ -502,15 +533,19 @@ int runCommandLine(int argc, char** argv) {
   app.footer(
       "Examples:\n  glint render scene.yaml -o scene.png --width 800\n"
       "  glint render scene.yaml --crop 0,0,400,300 -o top-left.ppm\n"
+      "  glint render model.glb            (a quick look at a mesh)\n"
+      "  glint convert balls.nff -o balls.yaml\n"
       "  glint check scene.yaml\n\nRun 'glint render --help' for the render options.\n\n" +
       exitStatus);
   render->footer(exitStatus);
   check->footer(exitStatus);
+  convert->footer(exitStatus);
 
   // CLI11 would call an unknown command a "missing subcommand"; say what happened instead.
   if (argc >= 2 && argv[1][0] != '-' && std::string_view(argv[1]) != "render" &&
-      std::string_view(argv[1]) != "check") {
-    printError(fmt::format("unknown command '{}'; the commands are render and check", argv[1]));
+      std::string_view(argv[1]) != "check" && std::string_view(argv[1]) != "convert") {
+    printError(
+        fmt::format("unknown command '{}'; the commands are render, check and convert", argv[1]));
     emit(stderr, "Run 'glint --help' for usage.\n");
     return kExitBadInput;
   }
@@ -536,6 +571,7 @@ int runCommandLine(int argc, char** argv) {
   args.resume = given(resumeOption, resume);
 
   if (check->parsed()) return runCheck(checkFile);
+  if (convert->parsed()) return runConvert(convertFile, convertOutput);
   SignalGuard signals;
   return runRender(args, signals);
 }

@@ -67,8 +67,30 @@ std::optional<Light> readSpot(ParameterDictionary& p, BuildContext& ctx) {
   const Attenuation attenuation = readAttenuation(p);
   double exponent = 1;
   if (const auto v = readNonNegative(p, "exponent")) exponent = *v;
+  // A falloff cone in degrees (Tachyon's spotlight): both angles, instead of the exponent.
+  const auto start = p.number("falloff_start");
+  const auto end = p.number("falloff_end");
+  double falloffStart = -1;
+  double falloffEnd = -1;
+  if (start || end) {
+    if (p.has("exponent")) {
+      p.error(p.keyPlace("exponent"),
+              "spot light has both 'exponent' and a falloff cone; give only one of them");
+    } else if (!start || !end) {
+      p.error(start ? start->where : end->where,
+              "spot light needs both 'falloff_start' and 'falloff_end' (degrees)");
+    } else if (!(start->value >= 0 && start->value < end->value && end->value <= 180)) {
+      p.error(end->where, fmt::format("spot light falloff angles must satisfy 0 <= falloff_start < "
+                                      "falloff_end <= 180, got {} and {}",
+                                      show(start->value), show(end->value)));
+    } else {
+      falloffStart = start->value;
+      falloffEnd = end->value;
+    }
+  }
   if (!position || !direction) return std::nullopt;
-  return SpotLight{position->value, *direction, power, attenuation, exponent};
+  return SpotLight{position->value, *direction,   power,     attenuation,
+                   exponent,        falloffStart, falloffEnd};
 }
 
 // The area shapes that have geometry key `key`, in table order.
@@ -158,6 +180,11 @@ std::optional<Light> readArea(ParameterDictionary& p, BuildContext& ctx) {
     light.edge1 = r->edge0;
     light.edge2 = r->edge1;
   } else if (const auto* disk = std::get_if<Disk>(&surface)) {
+    if (disk->innerRadius > 0) {
+      p.error(p.keyPlace("inner_radius"),
+              "a disk area light has no inner_radius (it is a whole disk)");
+      return std::nullopt;
+    }
     light.shape = AreaShape::Disk;
     light.center = disk->center;
     light.normal = Vec3{disk->normal.x, disk->normal.y, disk->normal.z};
@@ -180,7 +207,8 @@ const std::vector<LightFactory>& lightFactories() {
         {"directional", {"direction", "color", "intensity"}, readDirectional},
         {"point", {"position", "color", "intensity", "attenuation"}, readPoint},
         {"spot",
-         {"position", "direction", "color", "intensity", "attenuation", "exponent"},
+         {"position", "direction", "color", "intensity", "attenuation", "exponent", "falloff_start",
+          "falloff_end"},
          readSpot},
         {"area", {"shape", "color", "intensity", "attenuation", "samples"}, readArea},
     };

@@ -5,6 +5,7 @@
 // below, one row in objectFactories() — nothing else.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -12,16 +13,19 @@
 #include <vector>
 
 #include "glint/geometry/shape.h"
+#include "glint/mesh/mesh_file.h"
 #include "glint/readers/parameter_dictionary.h"
 
 namespace glint {
 
 // A mesh object before its file is read: the path as written (relative paths start at the scene
-// file's folder) and whether its vertex normals are interpolated.
+// file's folder) and whether its vertex normals are interpolated. An inline mesh (positions,
+// indices, ...) has no file: its contents are built already.
 struct MeshRequest {
   std::string file;
   ValueId fileWhere = kNoValue;
   bool smooth = true;
+  std::shared_ptr<const MeshFile> contents;  // an inline mesh; null for a file
 };
 
 using ObjectGeometry = std::variant<Shape, MeshRequest>;

@@ -80,6 +80,7 @@ class Builder {
     }
     if (const Entity* ambient = d_.first(EntityKind::AmbientEntity))
       buildAmbient(d_, *ambient, ctx_);
+    if (const Entity* fog = d_.first(EntityKind::FogEntity)) buildFog(d_, *fog, ctx_);
     if (const Entity* camera = d_.first(EntityKind::CameraEntity)) {
       buildCamera(d_, *camera, ctx_);
     } else if (d_.complete) {
@@ -342,15 +343,20 @@ class Builder {
     const std::filesystem::path path =
         written.is_relative() ? baseDirectory(params) / written : written;
     const std::string shown = escapeForMessage(request.file);
-    std::shared_ptr<const MeshFile> file;
+    // How messages name the mesh: its file, or the inline arrays.
+    const std::string named =
+        request.contents ? std::string("the inline mesh") : fmt::format("mesh file '{}'", shown);
+    std::shared_ptr<const MeshFile> file = request.contents;  // an inline mesh is built already
     try {
       // Estimated (mesh + BVH, with the film) against the memory limit before anything is read.
-      file = meshCache_.load(
-          path,
-          MeshBudget{options_.imageMemoryBudget,
-                     filmBytes(parts_.image.width, parts_.image.height) +
-                         static_cast<std::uint64_t>(textures_.bytes())},
-          MeshReadOptions{.sceneFolder = baseDirectory(params), .cancel = options_.cancel});
+      if (!file) {
+        file = meshCache_.load(
+            path,
+            MeshBudget{options_.imageMemoryBudget,
+                       filmBytes(parts_.image.width, parts_.image.height) +
+                           static_cast<std::uint64_t>(textures_.bytes())},
+            MeshReadOptions{.sceneFolder = baseDirectory(params), .cancel = options_.cancel});
+      }
     } catch (const MeshLoadError& e) {
       std::string reason = e.what();
       if (path != written && reason == "no such file") {
@@ -363,18 +369,18 @@ class Builder {
     const std::uint64_t triangles = file->triangleCount();
     if (meshTriangles_ + triangles > kMaxMeshTriangles) {
       params.error(params.place(),
-                   fmt::format("mesh file '{}' brings the scene's meshes to {} triangles, more "
+                   fmt::format("{} brings the scene's meshes to {} triangles, more "
                                "than the limit of {}",
-                               shown, formatCount(static_cast<double>(meshTriangles_ + triangles)),
+                               named, formatCount(static_cast<double>(meshTriangles_ + triangles)),
                                formatCount(static_cast<double>(kMaxMeshTriangles))));
       return;
     }
     meshTriangles_ += triangles;
     if (file->droppedTriangles > 0) {
       sink_.warning(params.location(),
-                    fmt::format("mesh file '{}': dropped {} degenerate triangle{} (zero area, "
+                    fmt::format("{}: dropped {} degenerate triangle{} (zero area, "
                                 "non-finite or invalid vertices); {} remain",
-                                shown, file->droppedTriangles,
+                                named, file->droppedTriangles,
                                 file->droppedTriangles == 1 ? "" : "s", triangles));
     }
     const std::vector<std::uint32_t>* scene = nullptr;

@@ -1,13 +1,17 @@
 #include "glint/factories/scene_loader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <functional>
 #include <map>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "glint/factories/quick_look.h"
 #include "glint/factories/scene_builder.h"
+#include "glint/readers/nff_reader.h"
+#include "glint/readers/tachyon_reader.h"
 #include "glint/readers/yaml_scene_reader.h"
 
 namespace glint {
@@ -29,7 +33,7 @@ struct InFileOrder {
   }
 };
 
-LoadedScene build(ParseResult parsed, const LoadOptions& options) {
+LoadedScene build(const ParseResult& parsed, const LoadOptions& options) {
   BuildOptions buildOptions;
   buildOptions.imageMemoryBudget = options.memoryBudget;
   buildOptions.overrides = options.overrides;
@@ -38,9 +42,10 @@ LoadedScene build(ParseResult parsed, const LoadOptions& options) {
 
   std::vector<Diagnostic> errors;
   std::vector<Diagnostic> warnings;
-  for (std::vector<Diagnostic>* list : {&parsed.diagnostics, &built.diagnostics}) {
-    for (Diagnostic& d : *list) {
-      (d.severity == Diagnostic::Severity::Error ? errors : warnings).push_back(std::move(d));
+  for (const std::vector<Diagnostic>* list :
+       {&parsed.diagnostics, static_cast<const std::vector<Diagnostic>*>(&built.diagnostics)}) {
+    for (const Diagnostic& d : *list) {
+      (d.severity == Diagnostic::Severity::Error ? errors : warnings).push_back(d);
     }
   }
   // The reader and the builder each report in their own walk of the file.
@@ -63,8 +68,21 @@ LoadedScene loadSceneFromString(std::string_view text, const std::string& displa
   return build(parseScene(text, displayName, baseDirectory, options.cancel), options);
 }
 
+LoadedScene buildDescribedScene(const ParseResult& parsed, const LoadOptions& options) {
+  return build(parsed, options);
+}
+
+ParseResult describeSceneFile(const std::filesystem::path& file, const LoadOptions& options) {
+  std::string extension = file.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".nff") return readNffFile(file, file.string(), options.cancel);
+  if (extension == ".dat") return readTachyonFile(file, file.string(), options.cancel);
+  if (isQuickLookFile(file)) return describeQuickLook(file, options);
+  return readSceneFile(file, file.string(), options.cancel);
+}
+
 LoadedScene loadScene(const std::filesystem::path& file, const LoadOptions& options) {
-  return build(readSceneFile(file, file.string(), options.cancel), options);
+  return build(describeSceneFile(file, options), options);
 }
 
 }  // namespace glint

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "glint/readers/diagnostics.h"
+#include "glint/readers/yaml_scene_reader.h"
 #include "glint/scene/scene.h"
 #include "glint/scene/scene_limits.h"
 #include "glint/scene/scene_overrides.h"
@@ -21,7 +22,7 @@ namespace glint {
 struct LoadedScene {
   SceneParts parts;
   std::vector<Diagnostic> warnings;
-  std::uint64_t sceneBytes = 0;        // size of the scene file (or text)
+  std::uint64_t sceneBytes = 0;  // size of the scene file (or text)
 };
 
 struct LoadOptions {
@@ -35,9 +36,19 @@ struct LoadOptions {
   const std::atomic<bool>* cancel = nullptr;
 };
 
-// Reads (streaming), parses and builds a scene file. Throws SceneError carrying every error found
-// (up to 20); a missing, unreadable or non-regular path (a folder, a FIFO, a device) is an error
-// naming only the file. Throws Cancelled when options.cancel is set while loading.
+// The scene file's entities, read by the reader its extension picks (DESIGN.md §13): .nff (NFF),
+// .dat (Tachyon), a mesh file's extension (.obj .ply .stl .gltf .glb: a quick look at the model,
+// factories/quick_look.h), anything else YAML (.yaml .yml .json). Throws as loadScene does.
+ParseResult describeSceneFile(const std::filesystem::path& file, const LoadOptions& options = {});
+
+// Builds what a reader described: throws SceneError with the reader's and the factories' errors
+// together, in file order; returns the scene with the warnings of both.
+LoadedScene buildDescribedScene(const ParseResult& parsed, const LoadOptions& options = {});
+
+// Reads (streaming), parses and builds a scene file of any format describeSceneFile reads. Throws
+// SceneError carrying every error found (up to 20); a missing, unreadable or non-regular path (a
+// folder, a FIFO, a device) is an error naming only the file. Throws Cancelled when options.cancel
+// is set while loading.
 LoadedScene loadScene(const std::filesystem::path& file, const LoadOptions& options = {});
 
 // The same for text in memory. `displayName` names the text in messages; relative paths inside it

@@ -235,6 +235,50 @@ void buildEnvironment(const ValueReader& reader, const Entity& e, BuildContext& 
 
 }  // namespace
 
+void buildFog(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
+  auto params = sectionParameters(scene, e, ctx,
+                                  "a mapping {type, start, end, density, color, distance}", "fog");
+  if (!params) return;
+  ParameterDictionary& p = *params;
+  p.declare({"type", "start", "end", "density", "color", "distance"});
+  const std::size_t errorsBefore = p.errors();
+  Fog fog;
+  // Reads a keyword of `choices` (the first is the default), or reports it.
+  const auto choice = [&p](std::string_view key, std::vector<std::string_view> choices,
+                           Presence presence) -> std::size_t {
+    const auto name = p.text(key, presence);
+    if (!name) return 0;
+    for (std::size_t i = 0; i < choices.size(); ++i) {
+      if (name->value == choices[i]) return i;
+    }
+    p.error(name->where,
+            fmt::format("fog.{} must be one of {}, got {}{}", key, fmt::join(choices, ", "),
+                        quoteForMessage(name->value), didYouMean(name->value, choices)));
+    return 0;
+  };
+  fog.falloff = static_cast<FogFalloff>(choice("type", {"linear", "exp", "exp2"}, kRequired));
+  fog.distance = static_cast<FogDistance>(choice("distance", {"ray", "depth"}, Presence::Optional));
+  if (const auto v = p.number("start")) fog.start = v->value;
+  if (fog.falloff == FogFalloff::Linear) {
+    if (const auto v = p.number("end", kRequired)) {
+      if (v->value > fog.start) {
+        fog.end = v->value;
+      } else {
+        p.error(v->where, fmt::format("fog.end must be > fog.start ({}), got {}", show(fog.start),
+                                      show(v->value)));
+      }
+    }
+  } else if (const auto v = readNonNegative(p, "density", kRequired)) {
+    fog.density = *v;
+  }
+  // Read (and checked) whatever the type, as Tachyon's FOG statement gives them all.
+  if (fog.falloff != FogFalloff::Linear) p.number("end");
+  if (fog.falloff == FogFalloff::Linear) readNonNegative(p, "density");
+  if (const auto c = readColor(p, "color", ctx.encoding)) fog.color = *c;
+  p.finish();
+  if (p.errors() == errorsBefore) ctx.parts.fog = fog;
+}
+
 void buildBackground(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
   const ValueReader reader = readerOf(scene, e, ctx);
   if (reader.tree().isMap(e.value)) {
@@ -259,15 +303,39 @@ void buildCamera(const SceneDescription& scene, const Entity& e, BuildContext& c
   if (!params) return;
   ParameterDictionary& p = *params;
   p.declare({"position", "direction", "look_at", "up", "view_plane", "fov", "aperture",
-             "focus_distance"});
+             "focus_distance", "projection"});
   CameraSpec& spec = ctx.parts.camera;
+  // Orthographic: parallel rays from the view plane, which then needs no distance (Tachyon's and
+  // VMD's orthographic camera).
+  if (const auto projection = p.text("projection")) {
+    if (projection->value == "orthographic") {
+      spec.orthographic = true;
+    } else if (projection->value != "perspective") {
+      p.error(projection->where,
+              fmt::format("camera.projection must be perspective or orthographic, got {}{}",
+                          quoteForMessage(projection->value),
+                          didYouMean(projection->value, std::vector<std::string_view>{
+                                                            "perspective", "orthographic"})));
+    }
+  }
+  if (spec.orthographic) {
+    for (const char* key : {"fov", "aperture", "focus_distance"}) {
+      if (p.has(key)) {
+        p.error(
+            p.keyPlace(key),
+            fmt::format("an orthographic camera has no '{}' (its view_plane sets the view)", key));
+      }
+    }
+  }
 
   // The either/or choices, at the later key when both are given.
   for (const auto& [a, b] : {std::pair{"direction", "look_at"}, std::pair{"view_plane", "fov"}}) {
     if (const ValueId later = p.laterKey(a, b); later != kNoValue) {
       p.error(later, fmt::format("camera has both '{}' and '{}'; give only one of them", a, b));
     } else if (!p.has(a) && !p.has(b)) {
-      p.error(p.place(), fmt::format("camera needs '{}' or '{}'", a, b));
+      p.error(p.place(), spec.orthographic && std::string_view(a) == "view_plane"
+                             ? std::string("an orthographic camera needs 'view_plane'")
+                             : fmt::format("camera needs '{}' or '{}'", a, b));
     }
   }
 
@@ -316,7 +384,10 @@ void buildCamera(const SceneDescription& scene, const Entity& e, BuildContext& c
     plane->declare({"width", "height", "distance"});
     if (const auto w = readPositive(*plane, "width", kRequired)) spec.viewPlaneWidth = *w;
     if (const auto h = readPositive(*plane, "height", kRequired)) spec.viewPlaneHeight = *h;
-    if (const auto d = readPositive(*plane, "distance", kRequired)) spec.viewPlaneDistance = *d;
+    if (const auto d =
+            readPositive(*plane, "distance", spec.orthographic ? Presence::Optional : kRequired)) {
+      spec.viewPlaneDistance = *d;
+    }
     plane->finish();
     // Square pixels also when the caller changed the image's aspect (--width and --height): the
     // view plane widens or narrows with the image, its height kept, as a fov camera's does.

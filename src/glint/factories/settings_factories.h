@@ -12,6 +12,8 @@ namespace glint {
 // ctx.encoding, ctx.imageOk and ctx.sceneImage.
 void buildImage(const SceneDescription& scene, const Entity& image, BuildContext& ctx);
 void buildRender(const SceneDescription& scene, const Entity& render, BuildContext& ctx);
+// fog: {type: linear | exp | exp2, start, end, density, color, distance: ray | depth}.
+void buildFog(const SceneDescription& scene, const Entity& e, BuildContext& ctx);
 void buildAmbient(const SceneDescription& scene, const Entity& ambient, BuildContext& ctx);
 void buildBackground(const SceneDescription& scene, const Entity& background, BuildContext& ctx);
 // camera: after the image (its size, and whether the image is valid).

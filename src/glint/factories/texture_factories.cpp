@@ -70,8 +70,9 @@ const std::array<Color, 2> kBlackWhite = {Color(0), Color(1)};
 std::optional<Texture> readChecker(ParameterDictionary& p, const TextureReadContext& ctx) {
   const auto colors = readColors(p, ctx, kBlackWhite);
   const auto scale = readPositive(p, "scale");
+  const auto center = p.point3("center");
   if (!colors || p.errors() != 0) return std::nullopt;
-  return CheckerTexture{*colors, scale.value_or(1)};
+  return CheckerTexture{*colors, scale.value_or(1), center ? center->value : Point3{}};
 }
 
 std::optional<Texture> readChecker2d(ParameterDictionary& p, const TextureReadContext& ctx) {
@@ -88,6 +89,7 @@ std::optional<Texture> readNoiseLike(ParameterDictionary& p, const TextureReadCo
   t.pattern = pattern;
   const auto c = readColors(p, ctx, colors);
   t.scale = readPositive(p, "scale").value_or(1);
+  if (const auto center = p.point3("center")) t.center = center->value;
   if (pattern != NoisePattern::Noise) {
     t.turbulence = readNonNegative(p, "turbulence").value_or(turbulence);
   }
@@ -175,11 +177,11 @@ std::optional<UvTransform> readUvTransform(ParameterDictionary& params, Point2 d
 
 const std::vector<TextureFactory>& textureFactories() {
   static const std::vector<TextureFactory> factories = {
-      {"checker", {"colors", "scale"}, readChecker},
+      {"checker", {"colors", "scale", "center"}, readChecker},
       {"checker2d", {"colors", "repeat", "offset", "rotate"}, readChecker2d},
-      {"noise", {"colors", "scale", "octaves"}, readNoise},
-      {"marble", {"colors", "scale", "turbulence", "octaves"}, readMarble},
-      {"wood", {"colors", "scale", "turbulence", "octaves"}, readWood},
+      {"noise", {"colors", "scale", "center", "octaves"}, readNoise},
+      {"marble", {"colors", "scale", "center", "turbulence", "octaves"}, readMarble},
+      {"wood", {"colors", "scale", "center", "turbulence", "octaves"}, readWood},
       {"image", {"file", "filter", "encoding", "repeat", "offset", "rotate"}, readImage},
   };
   return factories;

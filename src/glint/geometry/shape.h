@@ -169,20 +169,46 @@ struct Box {
   Normal3 normalAt(const Point3& p) const;
 };
 
-// Flat disk of `radius` around `center`, facing unit `normal`.
+// Flat disk of `radius` around `center`, facing unit `normal`; with innerRadius > 0 an annulus (a
+// ring: the points at distance innerRadius..radius from the centre).
 struct Disk {
   Point3 center;
   Normal3 normal;
   double radius = 1;
-  static Disk make(const Point3& center, const Vec3& normal, double radius);
+  double innerRadius = 0;  // 0 ≤ innerRadius < radius
+  static Disk make(const Point3& center, const Vec3& normal, double radius, double innerRadius = 0);
   bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
   int crossings(const Ray& ray, double tMin, double tMax) const;
   Bounds3 bounds() const;
   Normal3 normalAt(const Point3& p) const;
 };
 
+// Open cone frustum (no caps) from `base` to `apex` along unit `axis` (height |apex − base|), of
+// radius baseRadius at the base and apexRadius at the apex (any two radii ≥ 0, not both 0; equal
+// radii make an open cylinder). Intersected exactly as the quadric |q⊥|² = r(s)², s the distance
+// along the axis from the base, r(s) linear, cut to 0 ≤ s ≤ height. Outward normals (away from the
+// axis). Surface coordinates: u = φ/2π, φ the angle about the axis (right-handed) from
+// coneReference(axis) (the projection of +x onto the plane across the axis, or of +y when the axis
+// is along x), v = s/height (0 on the base rim, 1 on the apex rim). Implemented in cone.cpp.
+struct Cone {
+  Point3 base;
+  Vec3 axis;  // unit, from base toward apex
+  double height = 1;
+  double baseRadius = 1;
+  double apexRadius = 0;
+  static Cone make(const Point3& base, double baseRadius, const Point3& apex, double apexRadius);
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  Normal3 normalAt(const Point3& p) const;
+  Point2 uvAt(const Point3& p) const;
+};
+
+// The direction across a cone's unit axis from which its u coordinate is measured (see Cone).
+Vec3 coneReference(const Vec3& axis);
+
 using Shape = std::variant<Sphere, Plane, Triangle, Polygon, Rectangle, Quadrangle, Tube, Cylinder,
-                           Box, Disk>;
+                           Box, Disk, Cone>;
 
 // A shape placed in the world, optionally through an affine transform (worldFromObject), with what
 // the renderer needs to shade it. The seed's Geometry: shape + material + emission colour.

@@ -886,16 +886,23 @@ Normal3 Box::normalAt(const Point3& p) const {
 
 // ------------------------------------------------------------------------------------------ Disk
 
-Disk Disk::make(const Point3& center, const Vec3& normal, double radius) {
+Disk Disk::make(const Point3& center, const Vec3& normal, double radius, double innerRadius) {
   requireFinite("center", center);
   const Vec3 unitNormal = requireDirection("normal", normal);
-  return Disk{center, Normal3(unitNormal), requirePositive("radius", radius)};
+  requirePositive("radius", radius);
+  if (!(innerRadius >= 0 && innerRadius < radius)) {
+    throw ShapeError(
+        "inner_radius",
+        fmt::format("inner_radius must be >= 0 and < radius ({}), got {}", radius, innerRadius));
+  }
+  return Disk{center, Normal3(unitNormal), radius, innerRadius};
 }
 
 bool Disk::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
   double t;
   if (!planeParameter(center, normal, ray, t) || !inOpenRange(t, tMin, tMax)) return false;
-  if (distanceSquared(ray.at(t), center) > radius * radius) return false;
+  const double d2 = distanceSquared(ray.at(t), center);
+  if (d2 > radius * radius || d2 < innerRadius * innerRadius) return false;
   hit.t = t;
   hit.normal = normal;
   planeHitPoint(ray, t, center, normal, 0, hit);

@@ -35,6 +35,9 @@ struct TriangleMesh {
   // The mesh object's transform, for solid textures (evaluated in the object's own space); null
   // when the object has none.
   std::shared_ptr<const Transform> worldFromObject;
+  // Per vertex, linear; empty: none. Interpolated over each triangle, they multiply the material's
+  // kd and ka at the hit (Tachyon's per-vertex colours, VMD's coloured surfaces).
+  std::vector<Color> colors;
   std::uint32_t materialIndex = 0;  // into SceneParts::materials
   Color emission;
 

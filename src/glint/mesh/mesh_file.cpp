@@ -54,6 +54,7 @@ std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
     mesh.emission = part.emission;
     mesh.indices = part.indices;
     if (uvs) mesh.uvs = part.uvs;
+    mesh.colors = part.colors;
     if (mirror) {
       for (std::size_t i = 0; i + 2 < mesh.indices.size(); i += 3) {
         std::swap(mesh.indices[i + 1], mesh.indices[i + 2]);

@@ -29,6 +29,7 @@ enum class EntityKind : std::uint8_t {
   TextureEntity,   // a named texture of `textures`
   ObjectEntity,    // an entry of `objects`; its `type` names its factory
   LightEntity,     // an entry of `lights`; its `type` names its factory
+  FogEntity,       // distance fog
 };
 
 // One text a scene was read from.

@@ -41,9 +41,9 @@ yaml::Document readYamlFile(const std::filesystem::path& path, const std::string
                             const std::atomic<bool>* cancel);
 
 // The keys of a scene file's top level, and the ones an included file may hold too.
-const std::vector<std::string_view> kSceneKeys = {
-    "name", "background", "ambient", "camera", "image", "render",
-    "textures", "materials", "objects", "lights", "include"};
+const std::vector<std::string_view> kSceneKeys = {"name",      "background", "ambient", "fog",
+                                                  "camera",    "image",      "render",  "textures",
+                                                  "materials", "objects",    "lights",  "include"};
 const std::vector<std::string_view> kIncludedKeys = {"include", "textures", "materials"};
 
 // The sections of the top-level mapping as entities.
@@ -88,6 +88,7 @@ class TopLevel {
     if (const auto name = top.text("name")) scene_.name = name->where;
     section(top, "background", EntityKind::BackgroundEntity);
     section(top, "ambient", EntityKind::AmbientEntity);
+    section(top, "fog", EntityKind::FogEntity);
     section(top, "camera", EntityKind::CameraEntity);
     section(top, "image", EntityKind::ImageEntity);
     section(top, "render", EntityKind::RenderEntity);

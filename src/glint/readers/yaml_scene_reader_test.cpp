@@ -384,8 +384,8 @@ TEST(SceneParser, MeshKeyErrors) {
   expectOneError(objects + "  - {type: mesh, file: [a.obj]}\n", 4, 24,
                  "mesh.file: expected text, got a list of 1 item");
   expectOneError(objects + "  - {type: mesh, file: a.obj, smoth: true}\n", 4, 31,
-                 "unknown key 'smoth' in mesh; expected one of: file, smooth, material, emission, "
-                 "transform (did you mean 'smooth'?)");
+                 "unknown key 'smoth' in mesh; expected one of: file, smooth, positions, normals, "
+                 "colors, indices, material, emission, transform (did you mean 'smooth'?)");
   // Another shape's key is only unknown here (one error, not also a type error).
   expectOneError(objects + "  - {type: mesh, file: a.obj, radius: 1}\n", 4, 31,
                  "unknown key 'radius' in mesh");
@@ -402,7 +402,8 @@ TEST(SceneParser, UnknownTypesListTheKnownOnes) {
                  "unknown light type 'laser'; expected one of: directional, point, spot, area");
   expectOneError(std::string(kMinimal) + "objects:\n  - {type: sphre}\n", 4, 12,
                  "unknown object type 'sphre'; expected one of: sphere, plane, triangle, polygon, "
-                 "rectangle, quadrangle, tube, cylinder, box, disk, mesh (did you mean 'sphere'?)");
+                 "rectangle, quadrangle, tube, cylinder, box, disk, cone, mesh (did you mean "
+                 "'sphere'?)");
   expectOneError(std::string(kMinimal) + "lights:\n  - {type: ambient}\n", 4, 12,
                  "top-level key 'ambient'");
   expectOneError(std::string(kMinimal) + "image2: {}\n", 3, 1, "did you mean 'image'?");
@@ -484,8 +485,8 @@ TEST(SceneParser, AreaLightKeyErrors) {
   // A misspelt shape is one error: the unknown key, with the suggestion.
   expectLightError("{type: area, shap: disk, center: [0, 1, 0], radius: 1}", "shap",
                    "unknown key 'shap' in area light; expected one of: shape, color, intensity, "
-                   "attenuation, samples, corner, edges, center, normal, radius (did you mean "
-                   "'shape'?)");
+                   "attenuation, samples, corner, edges, center, normal, radius, inner_radius "
+                   "(did you mean 'shape'?)");
   expectLightError("{type: area, shape: square, corner: [0, 1, 0]}", "square",
                    "unknown area light shape 'square'; expected one of: rectangle, disk, sphere");
   expectLightError("{type: area, shape: spere, center: [0, 1, 0], radius: 1}", "spere",
@@ -836,7 +837,7 @@ TEST_F(IncludeFiles, IncludedTexturesJoinTheSceneAndAreNamedOnce) {
   write("twice.yaml", std::string("include: common/library.yaml\n") + kCameraImage +
                           "textures:\n  squares: {type: noise}\n");
   EXPECT_EQ(errorsOf("twice.yaml"),
-            (std::vector<std::string>{"twice.yaml:4:3: duplicate texture 'squares': defined "
+            (std::vector<std::string>{"twice.yaml:5:3: duplicate texture 'squares': defined "
                                       "twice (first at common/library.yaml:2:3)"}));
 }
 

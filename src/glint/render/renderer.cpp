@@ -77,6 +77,7 @@ enum class SecondaryKind { Reflection, Refraction };
 
 Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split,
             const SampleStream& stream, const RayDifferential* differential = nullptr);
+Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double t, int depth);
 
 // The position of a point or spot light; false for a directional light (at infinity).
 bool lightPosition(const Light& light, Point3& position) {
@@ -360,8 +361,26 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
                                          const RayDifferential* differential) {
   TexturedHit textured;
   shadeTexturedHit(ctx.scene, hit, differential, textured);
+  if (hit.mesh != kNoMesh && !ctx.scene.meshes()[hit.mesh].colors.empty()) {
+    const Color tint = ctx.scene.aggregate().vertexColor(hit);
+    textured.material.kd *= tint;
+    textured.material.ka *= tint;
+  }
   return shadeHit(ctx, ray, hit, textured.material, textured.emission, textured.shadingNormal,
                   depth, weight, split, stream, &textured, differential);
+}
+
+// An untextured scene's hit on a mesh with vertex colours: they tint kd and ka at the hit
+// (TriangleMesh::colors, Tachyon's and VMD's per-vertex colours).
+[[gnu::noinline]] Color traceVertexColouredHit(const TraceContext& ctx, const Ray& ray,
+                                               const Hit& hit, int depth, const Color& weight,
+                                               bool split, const SampleStream& stream) {
+  Material tinted = ctx.scene.materialOf(hit);
+  const Color tint = ctx.scene.aggregate().vertexColor(hit);
+  tinted.kd *= tint;
+  tinted.ka *= tint;
+  return shadeHit(ctx, ray, hit, tinted, ctx.scene.emissionOf(hit), hit.shadingNormal, depth,
+                  weight, split, stream, nullptr, nullptr);
 }
 
 // The seed's calcColor with recursion. `depth` counts the surface hits already on this path
@@ -374,14 +393,31 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   std::optional<Hit> deepHit;  // constructed only past the preallocated depths
   Hit& hit = depth < ctx.hitCount ? ctx.hits[depth] : deepHit.emplace();
   if (!ctx.scene.intersect(ray, kInfinity, hit)) {
+    // Fog measured along rays hides whatever lies at infinity.
+    if (const std::optional<Fog>& fog = ctx.scene.fog(); fog && fog->distance == FogDistance::Ray) {
+      return fog->color;
+    }
     return ctx.uniformBackground ? ctx.scene.background()
                                  : ctx.scene.backgroundAlong(ray.direction);
   }
+  Color color;
   if (ctx.textured) {
-    return traceTexturedHit(ctx, ray, hit, depth, weight, split, stream, differential);
+    color = traceTexturedHit(ctx, ray, hit, depth, weight, split, stream, differential);
+  } else if (hit.mesh != kNoMesh && !ctx.scene.meshes()[hit.mesh].colors.empty()) {
+    color = traceVertexColouredHit(ctx, ray, hit, depth, weight, split, stream);
+  } else {
+    color = shadeHit(ctx, ray, hit, ctx.scene.materialOf(hit), ctx.scene.emissionOf(hit),
+                     hit.shadingNormal, depth, weight, split, stream, nullptr, nullptr);
   }
-  return shadeHit(ctx, ray, hit, ctx.scene.materialOf(hit), ctx.scene.emissionOf(hit),
-                  hit.shadingNormal, depth, weight, split, stream, nullptr, nullptr);
+  return ctx.scene.fog() ? fogged(ctx, color, ray, hit.t, depth) : color;
+}
+
+// What a ray sees at its hit, seen through the fog over the distance t it travelled (Fog::distance
+// says how camera rays measure it).
+Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double t, int depth) {
+  const Fog& fog = *ctx.scene.fog();
+  const bool viewDepth = fog.distance == FogDistance::Depth && depth == 0;
+  return fog.apply(color, viewDepth ? t * dot(ray.direction, ctx.scene.camera().toward()) : t);
 }
 
 // Shading assumes a unit view direction. Camera rays are unit already up to rounding; normalising

@@ -30,7 +30,8 @@ Camera::Camera(const CameraSpec& spec)
       aperture_(spec.aperture),
       focusDistance_(spec.focusDistance),
       imageWidth_(spec.imageWidth),
-      imageHeight_(spec.imageHeight) {
+      imageHeight_(spec.imageHeight),
+      orthographic_(spec.orthographic) {
   if (!isFinite(spec.position)) throw CameraError("camera position must be finite");
   if (!isFinite(spec.direction)) throw CameraError("camera direction must be finite");
   if (!isFinite(spec.up)) throw CameraError("camera up must be finite");
@@ -64,7 +65,19 @@ Camera::Camera(const CameraSpec& spec)
                                   spec.imageWidth, spec.imageHeight));
   }
 
-  if (spec.fovDegrees != 0) {
+  if (spec.orthographic) {
+    if (spec.fovDegrees != 0 || spec.aperture != 0) {
+      throw CameraError("an orthographic camera has no fov and no aperture");
+    }
+    if (!(spec.viewPlaneWidth > 0 && spec.viewPlaneHeight > 0)) {
+      throw CameraError(fmt::format(
+          "an orthographic camera needs a view plane with width and height > 0 (got {}, {})",
+          spec.viewPlaneWidth, spec.viewPlaneHeight));
+    }
+    width_ = spec.viewPlaneWidth;
+    height_ = spec.viewPlaneHeight;
+    distance_ = 0;
+  } else if (spec.fovDegrees != 0) {
     if (!(spec.fovDegrees > 0 && spec.fovDegrees < 180)) {
       throw CameraError(
           fmt::format("camera fov must be in (0, 180) degrees, got {}", spec.fovDegrees));
@@ -103,6 +116,7 @@ Ray Camera::generateRay(int column, int row, const Point2& pixelOffset,
   const double ry = pitchY_;
   const double xj = (column + pixelOffset.x - 0.5 - (imageWidth_ - 1) / 2.0) * rx;
   const double yi = -(row + pixelOffset.y - 0.5 - (imageHeight_ - 1) / 2.0) * ry;
+  if (orthographic_) return Ray{position_ + right_ * xj + up_ * yi, toward_};
   // Pc + xJ·vRight + yI·vUp − p0, formed without the round trip through world positions.
   const Vec3 direction = normalize(toward_ * distance_ + right_ * xj + up_ * yi);
   if (aperture_ <= 0) return Ray{position_, direction};

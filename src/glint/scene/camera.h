@@ -25,6 +25,9 @@ struct CameraSpec {
   double focusDistance = 0;  // distance along vTo to the plane in focus (with aperture > 0)
   int imageWidth = 1;        // nX, pixels
   int imageHeight = 1;       // nY, pixels
+  // Parallel rays along vTo, one from each pixel's point of the view plane placed at p0 (its
+  // width × height in scene units; distance unused). No fov and no aperture.
+  bool orthographic = false;
 };
 
 class Camera {
@@ -50,6 +53,7 @@ class Camera {
   // Whether generateRay reads its lensSample (a thin lens, aperture > 0); a pinhole camera ignores
   // it, so callers may skip drawing one.
   bool hasLens() const { return aperture_ > 0; }
+  bool isOrthographic() const { return orthographic_; }
 
  private:
   Point3 position_;
@@ -57,6 +61,7 @@ class Camera {
   double width_ = 0, height_ = 0, distance_ = 0;
   double aperture_ = 0, focusDistance_ = 0;
   int imageWidth_ = 1, imageHeight_ = 1;
+  bool orthographic_ = false;
   // Pixel pitch on the view plane (width_ / imageWidth_, height_ / imageHeight_), scene units:
   // computed once instead of two divisions per camera ray.
   double pitchX_ = 0, pitchY_ = 0;

@@ -36,13 +36,23 @@ LightSample illuminate(const Light& light, const Point3& p) {
           if constexpr (std::is_same_v<T, SpotLight>) {
             // A spot lights only the half-space it faces, whatever the exponent (also 0, where
             // pow(0, 0) would be 1).
-            const double cosAngle = dot(l.direction, sample.toPoint);
-            sample.intensity *= cosAngle > 0 ? std::pow(cosAngle, l.exponent) : 0.0;
+            sample.intensity *= spotFactor(l, sample.toPoint);
           }
         }
         return sample;
       },
       light);
+}
+
+double spotFactor(const SpotLight& light, const Vec3& l) {
+  const double cosAngle = dot(light.direction, l);
+  if (light.falloffEnd >= 0) {
+    const double angle = std::acos(std::clamp(cosAngle, -1.0, 1.0)) * (180 / std::numbers::pi);
+    if (angle <= light.falloffStart) return 1;
+    if (angle >= light.falloffEnd) return 0;
+    return 1 - (angle - light.falloffStart) / (light.falloffEnd - light.falloffStart);
+  }
+  return cosAngle > 0 ? std::pow(cosAngle, light.exponent) : 0.0;
 }
 
 Point3 sampleAreaLight(const AreaLight& light, const Point3& p, const Point2& u) {

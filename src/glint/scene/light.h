@@ -29,14 +29,21 @@ struct PointLight {
   Attenuation attenuation;
 };
 
-// Point-light falloff × max(0, D·l)^exponent, D = unit `direction` the spot faces.
+// Point-light falloff × max(0, D·l)^exponent, D = unit `direction` the spot faces. With a falloff
+// cone (Tachyon's spotlight) the factor is instead 1 within falloffStart of D, falling linearly in
+// the angle to 0 at falloffEnd.
 struct SpotLight {
   Point3 position;
   Vec3 direction;
   Color intensity;  // I0 = color × intensity
   Attenuation attenuation;
   double exponent = 1;
+  double falloffStart = -1;  // degrees, 0 ≤ start < end ≤ 180; < 0: the exponent falloff
+  double falloffEnd = -1;
 };
+
+// The angular factor of a spot light toward the unit direction l (from the light to the point).
+double spotFactor(const SpotLight& light, const Vec3& l);
 
 // An area light (soft shadows): the shape's surface stands for `samples` point lights of intensity
 // I0 each, at stratified points over it; I_L(P) is their average, each attenuated by its own

@@ -93,6 +93,7 @@ Scene::Scene(SceneParts parts)
       ambient_(parts.ambient),
       background_(parts.background),
       environment_(std::move(parts.environment)),
+      fog_(parts.fog),
       camera_(cameraSpecFor(parts)),
       image_(std::move(parts.image)),
       render_(parts.render),

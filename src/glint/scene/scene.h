@@ -12,6 +12,7 @@
 #include "glint/core/color.h"
 #include "glint/scene/camera.h"
 #include "glint/scene/environment.h"
+#include "glint/scene/fog.h"
 #include "glint/scene/light.h"
 #include "glint/scene/material.h"
 #include "glint/scene/texture.h"
@@ -65,6 +66,7 @@ struct SceneParts {
   Color ambient;            // Ia = ambient color × ambient intensity
   Color background;         // linear; what a ray that misses returns (environment.kind Uniform)
   Environment environment;  // a gradient or an image instead of the one colour
+  std::optional<Fog> fog;   // none by default
   CameraSpec camera;        // imageWidth/imageHeight are overwritten from `image`
   ImageSettings image;
   RenderSettings render;
@@ -106,6 +108,7 @@ class Scene {
   bool uniformBackground() const { return environment_.kind == BackgroundKind::Uniform; }
   // What a ray leaving the scene along the unit direction d sees.
   Color backgroundAlong(const Vec3& d) const { return environment_.along(d, background_); }
+  const std::optional<Fog>& fog() const { return fog_; }
   const Camera& camera() const { return camera_; }
   const ImageSettings& image() const { return image_; }
   const RenderSettings& render() const { return render_; }
@@ -126,6 +129,7 @@ class Scene {
   Color ambient_;
   Color background_;
   Environment environment_;
+  std::optional<Fog> fog_;
   Camera camera_;
   ImageSettings image_;
   RenderSettings render_;

@@ -63,8 +63,9 @@ double tame(double x) {
 }
 
 Color evaluateNoise(const NoiseTexture& t, const Point3& objectPoint) {
-  const Point3 p{tame(objectPoint.x / t.scale), tame(objectPoint.y / t.scale),
-                 tame(objectPoint.z / t.scale)};
+  const Point3 p{tame((objectPoint.x - t.center.x) / t.scale),
+                 tame((objectPoint.y - t.center.y) / t.scale),
+                 tame((objectPoint.z - t.center.z) / t.scale)};
   double value = 0;
   switch (t.pattern) {
     case NoisePattern::Noise: {
@@ -197,8 +198,10 @@ Color evaluate(const Texture& texture, const TextureLookup& at) {
   if (const auto* t = std::get_if<ImageTexture>(&texture)) return evaluateImage(*t, at);
   if (const auto* t = std::get_if<CheckerTexture>(&texture)) {
     const Point3& p = at.objectPoint;
-    const double cells = std::floor(tame(p.x / t->scale)) + std::floor(tame(p.y / t->scale)) +
-                         std::floor(tame(p.z / t->scale));
+    const Point3& c = t->center;
+    const double cells = std::floor(tame((p.x - c.x) / t->scale)) +
+                         std::floor(tame((p.y - c.y) / t->scale)) +
+                         std::floor(tame((p.z - c.z) / t->scale));
     return t->colors[std::fmod(std::abs(cells), 2.0) == 1 ? 1 : 0];
   }
   if (const auto* t = std::get_if<Checker2dTexture>(&texture)) return evaluateChecker2d(*t, at);

@@ -40,11 +40,12 @@ struct UvTransform {
   }
 };
 
-// Solid checker: cell index floor(x/s) + floor(y/s) + floor(z/s) of the object-space point, even →
-// colors[0], odd → colors[1].
+// Solid checker: cell index floor(x/s) + floor(y/s) + floor(z/s) of the object-space point less
+// `center`, even → colors[0], odd → colors[1].
 struct CheckerTexture {
   std::array<Color, 2> colors;
   double scale = 1;  // cell size, object units
+  Point3 center;     // the pattern's origin, object space
 };
 
 // Checker on (u, v): after the transform, floor(u) + floor(v) even → colors[0]; box-filtered over
@@ -55,7 +56,7 @@ struct Checker2dTexture {
 };
 
 // Perlin noise solid textures (POV-Ray's and Tachyon's): each blends colors[0] → colors[1] by a
-// value in [0, 1] computed at the object-space point divided by `scale`.
+// value in [0, 1] computed at the object-space point less `center`, divided by `scale`.
 //  - noise: 0.5 + 0.5·fractal noise, `octaves` terms of noise(2^k·p)/2^k;
 //  - marble: 0.5 + 0.5·sin(π·(x + turbulence·turb(p))) — veins across x;
 //  - wood: the fractional part of the distance from the y axis plus turbulence·turb(p), as rings.
@@ -67,6 +68,7 @@ struct NoiseTexture {
   double scale = 1;
   double turbulence = 0;
   int octaves = 1;
+  Point3 center;  // the pattern's origin, object space
 };
 
 // A picture mapped on (u, v) (after the transform), through its shared mip-map.

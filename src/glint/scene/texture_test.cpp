@@ -85,14 +85,18 @@ TEST(MipMap, OddSizesAverageWithFractionalCoverage) {
 }
 
 TEST(Texture, SolidCheckerAtCellCentres) {
-  const Texture t = CheckerTexture{{Color(0.1), Color(0.9)}, 0.5};
-  for (int i = -3; i <= 3; ++i) {
-    for (int j = -3; j <= 3; ++j) {
-      for (int k = -3; k <= 3; ++k) {
-        const Point3 centre{(i + 0.5) * 0.5, (j + 0.5) * 0.5, (k + 0.5) * 0.5};
-        const bool odd = ((i + j + k) % 2 + 2) % 2 == 1;
-        EXPECT_EQ(evaluate(t, {centre, {}, {}, {}}).r, odd ? 0.9 : 0.1)
-            << i << " " << j << " " << k;
+  // The pattern's origin at `center`: the cell centres move with it.
+  for (const Point3 origin : {Point3{0, 0, 0}, Point3{0.2, -0.3, 1.1}}) {
+    const Texture t = CheckerTexture{{Color(0.1), Color(0.9)}, 0.5, origin};
+    for (int i = -3; i <= 3; ++i) {
+      for (int j = -3; j <= 3; ++j) {
+        for (int k = -3; k <= 3; ++k) {
+          const Point3 centre{origin.x + (i + 0.5) * 0.5, origin.y + (j + 0.5) * 0.5,
+                              origin.z + (k + 0.5) * 0.5};
+          const bool odd = ((i + j + k) % 2 + 2) % 2 == 1;
+          EXPECT_EQ(evaluate(t, {centre, {}, {}, {}}).r, odd ? 0.9 : 0.1)
+              << i << " " << j << " " << k;
+        }
       }
     }
   }
@@ -124,7 +128,7 @@ TEST(Texture, PerlinNoiseIsZeroOnTheLatticeAndBounded) {
   // The marble, wood and noise patterns stay between their two colours.
   for (const NoisePattern pattern :
        {NoisePattern::Noise, NoisePattern::Marble, NoisePattern::Wood}) {
-    const Texture t = NoiseTexture{pattern, {Color(0.2), Color(0.6)}, 0.3, 2, 4};
+    const Texture t = NoiseTexture{pattern, {Color(0.2), Color(0.6)}, 0.3, 2, 4, Point3{}};
     for (int i = 0; i < 200; ++i) {
       const double v = evaluate(t, {{i * 0.07, i * 0.05, -i * 0.03}, {}, {}, {}}).r;
       EXPECT_GE(v, 0.2 - kTol);

@@ -1,0 +1,507 @@
+#include "glint/readers/nff_reader.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "glint/core/cancel.h"
+#include "glint/core/vec.h"
+#include "glint/readers/mesh_collector.h"
+#include "glint/readers/text_statements.h"
+
+namespace glint {
+namespace {
+
+const std::vector<std::string_view> kStatements = {"v", "b", "l", "f", "c", "s", "p", "pp"};
+
+// Statements between polls of the cancel flag.
+constexpr std::size_t kStatementsPerPoll = 4096;
+// Vertices one polygon may have: far beyond any SPD polygon (the gears' 144), small enough that
+// ear clipping (quadratic in the vertices) stays fast.
+constexpr double kMaxPolygonVertices = 1 << 16;
+
+struct Fill {
+  std::string name;
+  double transmission = 0;
+  double ior = 1;
+  std::array<Token, 8> tokens;
+  std::string insideName;  // the material with 1/ior for inside-visible objects, once made
+};
+
+struct Light {
+  Token statement;
+  std::array<Token, 3> position;
+  std::optional<std::array<Token, 3>> color;
+};
+
+// A statement's numbers could not be read; the reader skips to the next statement.
+struct SyntaxError {};
+
+class NffReader {
+ public:
+  NffReader(std::string_view text, SceneEmitter& out, const std::atomic<bool>* cancel)
+      : tokens_(text), out_(out), cancel_(cancel) {}
+
+  void read() {
+    std::size_t statements = 0;
+    while (const std::optional<Token> t = tokens_.next()) {
+      if (++statements % kStatementsPerPoll == 0) throwIfCancelled(cancel_);
+      try {
+        statement(*t);
+      } catch (const SyntaxError&) {
+        skipToNextStatement();
+      }
+    }
+    if (!viewRead_ && !sawView_) {
+      out_.error({0, 1, 1},
+                 "the file has no viewpoint: an NFF scene needs a 'v' block (from, at, up, angle, "
+                 "hither, resolution)");
+    }
+    meshes_.emit(out_);
+    emitLights();
+  }
+
+ private:
+  void statement(const Token& t) {
+    const std::string_view s = t.text;
+    if (s == "v") {
+      view(t);
+    } else if (s == "b") {
+      background(t);
+    } else if (s == "l") {
+      light(t);
+    } else if (s == "f") {
+      fill(t);
+    } else if (s == "s") {
+      sphere(t);
+    } else if (s == "c") {
+      cone(t);
+    } else if (s == "p" || s == "pp") {
+      polygon(t, s == "pp");
+    } else {
+      const std::string nearest = nearestName(s, kStatements);
+      out_.error(t.at,
+                 fmt::format("unknown NFF statement {}{}; the statements are v, b, l, f, c, "
+                             "s, p, pp and # comments",
+                             quoteForMessage(s),
+                             nearest.empty() ? "" : fmt::format(" (did you mean '{}'?)", nearest)));
+      throw SyntaxError{};
+    }
+  }
+
+  // After an error: on to the next line that starts with a statement.
+  void skipToNextStatement() {
+    while (const std::optional<Token> t = tokens_.peek()) {
+      if (t->lineStart &&
+          std::find(kStatements.begin(), kStatements.end(), t->text) != kStatements.end()) {
+        return;
+      }
+      tokens_.next();
+    }
+  }
+
+  // The next token, which must exist: `what` says what was expected.
+  Token expectToken(const Token& statement, std::string_view what) {
+    std::optional<Token> t = tokens_.next();
+    if (!t) {
+      out_.error(tokens_.end(), fmt::format("the file ends inside '{}' (line {}): expected {}",
+                                            statement.text, statement.at.line, what));
+      throw SyntaxError{};
+    }
+    return *t;
+  }
+
+  // The next token as a number named `what` in messages.
+  double number(const Token& statement, std::string_view what, Token& token) {
+    token = expectToken(statement, fmt::format("a number ({})", what));
+    const std::optional<double> v = parseNumber(token.text);
+    if (!v) {
+      out_.error(token.at, fmt::format("{}: expected a number ({}), got {}", statement.text, what,
+                                       quoteForMessage(token.text)));
+      throw SyntaxError{};
+    }
+    return *v;
+  }
+
+  void numbers(const Token& statement, std::initializer_list<std::string_view> names, Token* tokens,
+               double* values) {
+    std::size_t i = 0;
+    for (const std::string_view name : names) {
+      values[i] = number(statement, name, tokens[i]);
+      ++i;
+    }
+  }
+
+  void keyword(const Token& statement, std::string_view word) {
+    const Token t = expectToken(statement, fmt::format("'{}'", word));
+    if (t.text != word) {
+      out_.error(t.at, fmt::format("{}: expected '{}', got {} (a viewpoint is v, from, at, up, "
+                                   "angle, hither, resolution, in this order)",
+                                   statement.text, word, quoteForMessage(t.text)));
+      throw SyntaxError{};
+    }
+  }
+
+  // --- v: the viewpoint --------------------------------------------------------------------
+
+  void view(const Token& v) {
+    sawView_ = true;
+    if (viewRead_) {
+      out_.error(v.at, "a second viewpoint ('v'); an NFF file has one");
+      throw SyntaxError{};
+    }
+    std::array<Token, 3> from, at, up;
+    double unused[3];
+    keyword(v, "from");
+    numbers(v, {"from x", "from y", "from z"}, from.data(), unused);
+    keyword(v, "at");
+    numbers(v, {"at x", "at y", "at z"}, at.data(), unused);
+    keyword(v, "up");
+    numbers(v, {"up x", "up y", "up z"}, up.data(), unused);
+    keyword(v, "angle");
+    Token angle;
+    const double degrees = number(v, "angle, degrees", angle);
+    keyword(v, "hither");
+    Token hither;
+    number(v, "hither", hither);
+    keyword(v, "resolution");
+    std::array<Token, 2> resolution;
+    double size[2];
+    numbers(v, {"x resolution", "y resolution"}, resolution.data(), size);
+    viewRead_ = true;
+    if (!(degrees > 0 && degrees < 180)) {
+      out_.error(angle.at, fmt::format("v: angle must be in (0, 180) degrees, got {}",
+                                       shortenForMessage(angle.text)));
+      return;
+    }
+    // NFF.TXT: the angle spans the centres of the top and bottom pixel rows, so the pixel pitch
+    // at distance 1 is 2·tan(angle/2)/(rows − 1); square pixels.
+    const double rows = std::max(std::round(size[1]), 1.0);
+    const double columns = std::max(std::round(size[0]), 1.0);
+    const double span = 2 * std::tan(degrees * std::numbers::pi / 360);
+    const double pitch = rows > 1 ? span / (rows - 1) : span;
+
+    ValueId map = out_.nextId();
+    out_.openMap(v.at);
+    out_.triple("position", from.data());
+    out_.triple("look_at", at.data());
+    out_.triple("up", up.data());
+    out_.key("view_plane", angle.at);
+    out_.openMap(angle.at);
+    out_.entry("width", numberText(pitch * columns), angle.at);
+    out_.entry("height", numberText(pitch * rows), angle.at);
+    out_.entry("distance", "1", angle.at);
+    out_.close();
+    out_.close();
+    out_.addEntity(EntityKind::CameraEntity, map);
+
+    map = out_.nextId();
+    out_.openMap(resolution[0].at);
+    out_.entry("width", resolution[0]);
+    out_.entry("height", resolution[1]);
+    out_.entry("encoding", "linear", v.at);
+    out_.close();
+    out_.addEntity(EntityKind::ImageEntity, map);
+
+    map = out_.nextId();
+    out_.openMap(v.at);
+    out_.entry("max_depth", "5", v.at);
+    out_.entry("min_weight", "0", v.at);
+    out_.close();
+    out_.addEntity(EntityKind::RenderEntity, map);
+  }
+
+  // --- b, l, f -------------------------------------------------------------------------------
+
+  void background(const Token& b) {
+    std::array<Token, 3> rgb;
+    double unused[3];
+    numbers(b, {"red", "green", "blue"}, rgb.data(), unused);
+    const ValueId list = out_.nextId();
+    out_.openList(rgb[0].at);
+    for (const Token& t : rgb) out_.scalar(t);
+    out_.close();
+    out_.addEntity(EntityKind::BackgroundEntity, list);
+  }
+
+  void light(const Token& l) {
+    Light light{l, {}, std::nullopt};
+    double unused[3];
+    numbers(l, {"x", "y", "z"}, light.position.data(), unused);
+    // The colour is optional: three more numbers.
+    if (const std::optional<Token> next = tokens_.peek(); next && parseNumber(next->text)) {
+      std::array<Token, 3> rgb;
+      numbers(l, {"red", "green", "blue"}, rgb.data(), unused);
+      light.color = rgb;
+    }
+    lights_.push_back(std::move(light));
+  }
+
+  void emitLights() {
+    if (lights_.empty()) return;
+    const std::string intensity = numberText(1 / std::sqrt(static_cast<double>(lights_.size())));
+    for (const Light& l : lights_) {
+      const ValueId map = out_.nextId();
+      out_.openMap(l.statement.at);
+      const ValueId type = out_.entry("type", "point", l.statement.at);
+      out_.triple("position", l.position.data());
+      if (l.color) out_.triple("color", l.color->data());
+      out_.entry("intensity", intensity, l.statement.at);
+      out_.close();
+      out_.addEntity(EntityKind::LightEntity, map, type);
+    }
+  }
+
+  void fill(const Token& f) {
+    Fill fill;
+    double v[8];
+    numbers(f, {"red", "green", "blue", "Kd", "Ks", "Shine", "T", "index of refraction"},
+            fill.tokens.data(), v);
+    fill.name = fmt::format("fill{}", fills_.size() + 1);
+    fill.transmission = v[6];
+    fill.ior = v[7];
+    emitFill(fill, fill.name, false);
+    fills_.push_back(std::move(fill));
+  }
+
+  // kd = Kd·colour (at Kd), ks = kr = Ks, shininess = Shine, kt = T, and ior when T > 0 (inverted
+  // for the inside-visible variant).
+  void emitFill(const Fill& fill, const std::string& name, bool inside) {
+    const std::array<Token, 8>& t = fill.tokens;
+    const ValueId nameValue = out_.scalar(name, t[3].at);
+    const ValueId map = out_.nextId();
+    out_.openMap(t[0].at);
+    const double kd = *parseNumber(t[3].text);
+    const double rgb[3] = {kd * *parseNumber(t[0].text), kd * *parseNumber(t[1].text),
+                           kd * *parseNumber(t[2].text)};
+    out_.computedTriple("kd", rgb, t[3].at);
+    out_.entry("ks", t[4]);
+    out_.entry("shininess", t[5]);
+    out_.entry("kr", t[4]);
+    out_.entry("kt", t[6]);
+    if (fill.transmission > 0) {
+      if (inside && fill.ior != 0) {
+        out_.entry("ior", numberText(1 / fill.ior), t[7].at);
+      } else {
+        out_.entry("ior", t[7]);
+      }
+    }
+    out_.close();
+    out_.addEntity(EntityKind::MaterialEntity, map, kNoValue, nameValue);
+  }
+
+  // The material objects take now: the last fill, or its inside-visible variant.
+  std::string material(bool inside) {
+    if (fills_.empty()) return {};
+    Fill& fill = fills_.back();
+    if (!inside || fill.transmission <= 0 || fill.ior == 1) return fill.name;
+    if (fill.insideName.empty()) {
+      fill.insideName = fill.name + "_inside";
+      emitFill(fill, fill.insideName, true);
+    }
+    return fill.insideName;
+  }
+
+  // --- s, c ----------------------------------------------------------------------------------
+
+  // A radius token without its minus sign (an exact negation).
+  static Token unsigned_(Token t) {
+    if (!t.text.empty() && t.text[0] == '-') t.text.remove_prefix(1);
+    return t;
+  }
+
+  void sphere(const Token& s) {
+    std::array<Token, 4> t;
+    double v[4];
+    numbers(s, {"center x", "center y", "center z", "radius"}, t.data(), v);
+    const bool inside = v[3] < 0;
+    const std::string m = material(inside);  // may emit a material: before the sphere's mapping
+    const ValueId map = out_.nextId();
+    out_.openMap(s.at);
+    const ValueId type = out_.entry("type", "sphere", s.at);
+    out_.triple("center", t.data());
+    out_.entry("radius", inside ? unsigned_(t[3]) : t[3]);
+    if (!m.empty()) out_.entry("material", m, s.at);
+    out_.close();
+    out_.addEntity(EntityKind::ObjectEntity, map, type);
+  }
+
+  void cone(const Token& c) {
+    std::array<Token, 8> t;
+    double v[8];
+    numbers(
+        c,
+        {"base x", "base y", "base z", "base radius", "apex x", "apex y", "apex z", "apex radius"},
+        t.data(), v);
+    const bool inside = (v[3] < 0 || v[7] < 0) && v[3] <= 0 && v[7] <= 0;
+    if (!inside && (v[3] < 0 || v[7] < 0)) {
+      out_.error(t[v[3] < 0 ? 3 : 7].at,
+                 "c: a negative radius needs the other one negative too (both negative: only the "
+                 "inside is visible)");
+      return;
+    }
+    const std::string m = material(inside);
+    const ValueId map = out_.nextId();
+    out_.openMap(c.at);
+    const ValueId type = out_.entry("type", "cone", c.at);
+    out_.triple("base", &t[0]);
+    out_.entry("base_radius", inside ? unsigned_(t[3]) : t[3]);
+    out_.triple("apex", &t[4]);
+    out_.entry("apex_radius", inside ? unsigned_(t[7]) : t[7]);
+    if (!m.empty()) out_.entry("material", m, c.at);
+    out_.close();
+    out_.addEntity(EntityKind::ObjectEntity, map, type);
+  }
+
+  // --- p, pp ---------------------------------------------------------------------------------
+
+  void polygon(const Token& p, bool patch) {
+    Token countToken;
+    const double count = number(p, "number of vertices", countToken);
+    if (!(count >= 3 && count == std::floor(count) && count <= kMaxPolygonVertices)) {
+      out_.error(countToken.at,
+                 fmt::format("{}: the number of vertices must be a whole number from 3 to {}, "
+                             "got {}",
+                             p.text, kMaxPolygonVertices, shortenForMessage(countToken.text)));
+      throw SyntaxError{};
+    }
+    const auto n = static_cast<std::size_t>(count);
+    std::vector<CollectedVertex> vertices(n);
+    std::vector<Point3> points(n);
+    ValueTree& tree = out_.tree();
+    for (std::size_t i = 0; i < n; ++i) {
+      Token t[6];
+      double v[6];
+      if (patch) {
+        numbers(p, {"vertex x", "vertex y", "vertex z", "normal x", "normal y", "normal z"}, t, v);
+      } else {
+        numbers(p, {"vertex x", "vertex y", "vertex z"}, t, v);
+      }
+      for (int k = 0; k < 3; ++k) {
+        vertices[i].position[k] = tree.addScalar(t[k].text, t[k].at);
+        if (patch) vertices[i].normal[k] = tree.addScalar(t[k + 3].text, t[k + 3].at);
+      }
+      points[i] = Point3{v[0], v[1], v[2]};
+    }
+    const std::string m = material(false);
+    const std::vector<std::array<std::size_t, 3>> triangles = triangulate(points);
+    if (triangles.empty()) {
+      out_.warning(p.at, fmt::format("{}: the polygon's vertices are collinear (no area); it is "
+                                     "left out",
+                                     p.text));
+      return;
+    }
+    for (const auto& tri : triangles) {
+      meshes_.add(tree, m, vertices[tri[0]], vertices[tri[1]], vertices[tri[2]], p.at);
+    }
+  }
+
+  // Ear clipping (Meisters 1975) of a planar polygon, projected onto the coordinate plane its
+  // normal (Newell's) is most perpendicular to. Triangles keep the polygon's vertex order. A
+  // polygon that clipping cannot finish (self-intersecting, repeated vertices) gets a fan for the
+  // rest.
+  static std::vector<std::array<std::size_t, 3>> triangulate(const std::vector<Point3>& p) {
+    const std::size_t n = p.size();
+    Vec3 normal;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Point3& a = p[i];
+      const Point3& b = p[(i + 1) % n];
+      normal +=
+          Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
+    }
+    std::vector<std::array<std::size_t, 3>> out;
+    if (!(length(normal) > 0)) return out;
+    if (n == 3) return {{0, 1, 2}};
+    const Vec3 an = abs(normal);
+    const int drop = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+    const double sign = normal[drop] > 0 ? 1 : -1;
+    const auto u = [&](std::size_t i) { return p[i][(drop + 1) % 3]; };
+    const auto w = [&](std::size_t i) { return p[i][(drop + 2) % 3]; };
+    const auto turn = [&](std::size_t a, std::size_t b, std::size_t c) {
+      return sign * ((u(b) - u(a)) * (w(c) - w(a)) - (w(b) - w(a)) * (u(c) - u(a)));
+    };
+    std::vector<std::size_t> ring(n);
+    for (std::size_t i = 0; i < n; ++i) ring[i] = i;
+    while (ring.size() > 3) {
+      const std::size_t m = ring.size();
+      bool clipped = false;
+      for (std::size_t i = 0; i < m && !clipped; ++i) {
+        const std::size_t a = ring[(i + m - 1) % m];
+        const std::size_t b = ring[i];
+        const std::size_t c = ring[(i + 1) % m];
+        if (!(turn(a, b, c) > 0)) continue;  // a reflex or straight corner is no ear
+        bool empty = true;
+        for (const std::size_t q : ring) {
+          if (q == a || q == b || q == c) continue;
+          if (turn(a, b, q) >= 0 && turn(b, c, q) >= 0 && turn(c, a, q) >= 0) {
+            empty = false;
+            break;
+          }
+        }
+        if (!empty) continue;
+        out.push_back({a, b, c});
+        ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(i));
+        clipped = true;
+      }
+      if (!clipped) {
+        for (std::size_t i = 1; i + 1 < ring.size(); ++i) {
+          out.push_back({ring[0], ring[i], ring[i + 1]});
+        }
+        return out;
+      }
+    }
+    out.push_back({ring[0], ring[1], ring[2]});
+    return out;
+  }
+
+  Tokenizer tokens_;
+  SceneEmitter& out_;
+  const std::atomic<bool>* cancel_;
+  bool viewRead_ = false;
+  bool sawView_ = false;
+  std::vector<Fill> fills_;
+  std::vector<Light> lights_;
+  MeshCollector meshes_;
+};
+
+ParseResult finish(SceneDescription scene, Diagnostics& sink) {
+  ParseResult result;
+  scene.complete = !sink.hasErrors();
+  result.description = std::move(scene);
+  result.diagnostics = sink.take();
+  return result;
+}
+
+ParseResult parse(std::string_view text, SceneDescription scene, const std::atomic<bool>* cancel) {
+  Diagnostics sink;
+  SceneEmitter out(scene, sink);
+  NffReader(text, out, cancel).read();
+  return finish(std::move(scene), sink);
+}
+
+}  // namespace
+
+ParseResult parseNff(std::string_view text, const std::string& file,
+                     const std::filesystem::path& baseDirectory, const std::atomic<bool>* cancel) {
+  SceneDescription scene = sceneWithFile(file, baseDirectory);
+  scene.files[0]->bytes = text.size();
+  return parse(text, std::move(scene), cancel);
+}
+
+ParseResult readNffFile(const std::filesystem::path& path, const std::string& name,
+                        const std::atomic<bool>* cancel) {
+  std::filesystem::path base = path.parent_path();
+  if (base.empty()) base = ".";
+  SceneDescription scene = sceneWithFile(name, base);
+  const std::string text = readWholeSceneFile(path, name, *scene.files[0]);
+  return parse(text, std::move(scene), cancel);
+}
+
+}  // namespace glint

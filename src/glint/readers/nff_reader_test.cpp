@@ -1,0 +1,179 @@
+// The NFF reader (nff_reader.h): every statement as the entities the YAML reader would emit, values
+// at their tokens' places, and its errors at file:line:col.
+#include "glint/readers/nff_reader.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "glint/factories/scene_loader.h"
+
+namespace glint {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Every NFF statement: the viewpoint, background, lights with and without colour, fills (one
+// transparent), spheres (one inside-visible), a cone, polygons (one concave) and patches, comments.
+constexpr const char* kEveryStatement = R"(# an SPD-like file
+b 0.1 0.2 0.3
+v
+from 0 -10 2
+at 0 0 0
+up 0 0 1
+angle 40
+hither 1
+resolution 40 30
+l 5 -5 5
+l -5 -5 5 1 0.5 0.5   # a coloured light
+f 1 0.5 0.25 0.8 0.2 30 0 1
+s 0 0 0 1
+c 2 0 -1 0.5 2 0 1 0.25
+p 6
+-3 -3 -1  3 -3 -1  3 3 -1  0 3 -1  0 0 -1  -3 0 -1
+f 1 1 1 0.1 0.5 100 0.8 1.5
+s -2 0 0 -0.5
+pp 3
+0 0 2 0 0 1
+1 0 2 0 0.1 1
+0 1 2 0.1 0 1
+)";
+
+std::size_t count(const ParseResult& r, EntityKind kind) { return r.description.count(kind); }
+
+std::string text(const ParseResult& r, const Entity& e, std::string_view key) {
+  return std::string(r.description.text(e, r.description.parameter(e, key)));
+}
+
+const Entity& nth(const ParseResult& r, EntityKind kind, std::size_t n) {
+  for (const Entity& e : r.description.entities) {
+    if (e.kind == kind && n-- == 0) return e;
+  }
+  throw std::logic_error("no such entity");
+}
+
+std::string firstError(const ParseResult& r) {
+  for (const Diagnostic& d : r.diagnostics) {
+    if (d.severity == Diagnostic::Severity::Error) return d.format();
+  }
+  return "<no error>";
+}
+
+TEST(NffReader, EveryStatementBecomesTheEntitiesOfAYamlScene) {
+  const ParseResult r = parseNff(kEveryStatement, "every.nff");
+  ASSERT_FALSE(r.hasErrors()) << firstError(r);
+  EXPECT_EQ(count(r, EntityKind::CameraEntity), 1u);
+  EXPECT_EQ(count(r, EntityKind::ImageEntity), 1u);
+  EXPECT_EQ(count(r, EntityKind::RenderEntity), 1u);
+  EXPECT_EQ(count(r, EntityKind::BackgroundEntity), 1u);
+  EXPECT_EQ(count(r, EntityKind::AmbientEntity), 0u);
+  EXPECT_EQ(count(r, EntityKind::LightEntity), 2u);
+  // fill1, fill2 and fill2's inside-visible variant (1/ior) for the negative sphere.
+  ASSERT_EQ(count(r, EntityKind::MaterialEntity), 3u);
+  // Two spheres, a cone, a mesh of polygons and a mesh of patches.
+  EXPECT_EQ(count(r, EntityKind::ObjectEntity), 5u);
+
+  const Entity& light = nth(r, EntityKind::LightEntity, 1);
+  EXPECT_EQ(text(r, light, "intensity"), "0.7071067811865475");  // 1/√2
+  const SourceLocation at = r.description.location(light, r.description.parameter(light, "color"));
+  EXPECT_EQ(at.line, 11);
+  EXPECT_EQ(at.column, 11);
+
+  const Entity& fill = nth(r, EntityKind::MaterialEntity, 0);
+  const ValueTree& t = r.description.files[0]->values;
+  const ValueId kd = r.description.parameter(fill, "kd");
+  EXPECT_EQ(t.scalar(t.item(kd, 1)), "0.4");                  // Kd · green = 0.8 · 0.5
+  EXPECT_EQ(text(r, fill, "kr"), "0.2");                      // kr = Ks
+  EXPECT_EQ(r.description.parameter(fill, "ior"), kNoValue);  // opaque: no ior
+
+  const Entity& inside = nth(r, EntityKind::MaterialEntity, 2);
+  EXPECT_EQ(r.description.text(inside, inside.name), "fill2_inside");
+  EXPECT_EQ(text(r, inside, "ior"), "0.6666666666666666");
+  const Entity& negative = nth(r, EntityKind::ObjectEntity, 2);
+  EXPECT_EQ(text(r, negative, "radius"), "0.5");
+  EXPECT_EQ(text(r, negative, "material"), "fill2_inside");
+
+  // The camera: look_at, and a view plane on which the centres of the top and bottom rows are
+  // 40° apart: height = 2·tan(20°)·30/29.
+  const Entity& camera = nth(r, EntityKind::CameraEntity, 0);
+  const ValueId plane = r.description.parameter(camera, "view_plane");
+  double height = 0;
+  for (std::size_t i = 0; i < t.size(plane); ++i) {
+    if (t.scalar(t.key(plane, i)) == "height")
+      height = std::stod(std::string(t.scalar(t.value(plane, i))));
+  }
+  EXPECT_NEAR(height, 2 * std::tan(20 * M_PI / 180) * 30 / 29, 1e-15);
+
+  // The concave L-shaped hexagon (area 27) becomes 4 triangles.
+  const Entity& polygons = nth(r, EntityKind::ObjectEntity, 3);
+  EXPECT_EQ(text(r, polygons, "type"), "mesh");
+  EXPECT_EQ(text(r, polygons, "smooth"), "false");
+  EXPECT_EQ(t.size(r.description.parameter(polygons, "indices")), 4u);
+  const Entity& patches = nth(r, EntityKind::ObjectEntity, 4);
+  EXPECT_NE(r.description.parameter(patches, "normals"), kNoValue);
+
+  // And it builds.
+  const LoadedScene loaded = buildDescribedScene(r);
+  EXPECT_EQ(loaded.parts.primitives.size(), 3u);
+  ASSERT_EQ(loaded.parts.meshes.size(), 2u);
+  double area = 0;
+  const TriangleMesh& m = loaded.parts.meshes[0];
+  for (std::size_t i = 0; i < m.indices.size(); i += 3) {
+    area += length(cross(m.positions[m.indices[i + 1]] - m.positions[m.indices[i]],
+                         m.positions[m.indices[i + 2]] - m.positions[m.indices[i]])) /
+            2;
+  }
+  EXPECT_NEAR(area, 27, 1e-9);
+}
+
+TEST(NffReader, ErrorsNameTheirLineAndColumn) {
+  const auto error = [](const std::string& body) {
+    return firstError(parseNff(
+        "v from 0 0 5 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 8 8\n" + body, "bad.nff"));
+  };
+  EXPECT_EQ(error("sphere 0 0 0 1\n"),
+            "bad.nff:2:1: unknown NFF statement 'sphere'; the statements are v, b, l, f, c, s, p, "
+            "pp and # comments");
+  EXPECT_EQ(error("pq 3\n"),
+            "bad.nff:2:1: unknown NFF statement 'pq' (did you mean 'p'?); the statements are v, "
+            "b, l, f, c, s, p, pp and # comments");
+  EXPECT_EQ(error("s 0 0 x 1\n"), "bad.nff:2:7: s: expected a number (center z), got 'x'");
+  EXPECT_EQ(error("c 0 0 0 1 0 0 1\n"),
+            "bad.nff:3:1: the file ends inside 'c' (line 2): expected a number (apex radius)");
+  EXPECT_EQ(error("c 0 0 0 -1 0 0 1 1\n"),
+            "bad.nff:2:9: c: a negative radius needs the other one negative too (both negative: "
+            "only the inside is visible)");
+  EXPECT_EQ(error("p 2\n0 0 0 1 1 1\n"),
+            "bad.nff:2:3: p: the number of vertices must be a whole number from 3 to 65536, got 2");
+  EXPECT_THAT(firstError(parseNff("s 0 0 0 1\n", "none.nff")),
+              HasSubstr("none.nff:1:1: the file has no viewpoint"));
+  EXPECT_EQ(firstError(parseNff("v from 0 0 5 at 0 0 0 up 0 1 0 angle 180 hither 1 resolution 8 8",
+                                "a.nff")),
+            "a.nff:1:38: v: angle must be in (0, 180) degrees, got 180");
+  EXPECT_EQ(firstError(parseNff("v from 0 0 5 to 0 0 0", "a.nff")),
+            "a.nff:1:14: v: expected 'at', got 'to' (a viewpoint is v, from, at, up, angle, "
+            "hither, resolution, in this order)");
+}
+
+TEST(NffReader, ReadingGoesOnAfterAnErrorAndTheFactoriesReportAtTheTokens) {
+  const ParseResult r = parseNff(
+      "v from 0 0 5 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 8 8\n"
+      "s 0 0 oops 1\n"
+      "s 0 0 0 0\n",
+      "two.nff");
+  ASSERT_EQ(r.diagnostics.size(), 1u);
+  EXPECT_EQ(r.diagnostics[0].where.line, 2);
+  try {
+    buildDescribedScene(r);
+    FAIL() << "expected errors";
+  } catch (const SceneError& e) {
+    ASSERT_EQ(e.diagnostics().size(), 2u);
+    // The factory's own check, at the radius token of line 3.
+    EXPECT_EQ(e.diagnostics()[1].format(), "two.nff:3:9: sphere.radius must be > 0, got 0");
+  }
+}
+
+}  // namespace
+}  // namespace glint

@@ -1,0 +1,492 @@
+#include "glint/readers/tachyon_reader.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "glint/core/cancel.h"
+#include "glint/core/vec.h"
+#include "glint/readers/spelling.h"
+#include "glint/readers/tachyon_geometry.h"
+#include "glint/readers/tachyon_texture.h"
+#include "glint/readers/text_statements.h"
+
+namespace glint {
+namespace {
+
+using namespace tachyon;
+
+const std::vector<std::string_view> kSupported = {"CAMERA",      "LIGHT",       "DIRECTIONAL_LIGHT",
+                                                  "SPOTLIGHT",   "BACKGROUND",  "FOG",
+                                                  "SHADER_MODE", "SPHERE",      "FCYLINDER",
+                                                  "CYLINDER",    "RING",        "PLANE",
+                                                  "BOX",         "TRI",         "STRI",
+                                                  "VCSTRI",      "VERTEXARRAY", "TEXDEF",
+                                                  "TEXALIAS",    "END_SCENE"};
+// Tachyon statements glint does not read (yet), reported by name rather than as unknown words.
+const std::vector<std::string_view> kUnsupported = {
+    "BACKGROUND_GRADIENT", "SPHEREARRAY",  "POLYCYLINDER", "SCALARVOL", "IMAGEDEF",
+    "SKY_LIGHT",           "SCAPE",        "TPOLYFILE",    "MGFFILE",   "INCLUDE",
+    "START_CLIPGROUP",     "END_CLIPGROUP"};
+
+constexpr std::size_t kStatementsPerPoll = 1024;
+
+// The supported statement nearest to `word` (always one).
+std::string_view nearestSupported(std::string_view word) {
+  std::string_view best = kSupported[0];
+  std::size_t bestDistance = SIZE_MAX;
+  for (const std::string_view s : kSupported) {
+    const std::size_t d = editDistance(word, s);
+    if (d < bestDistance) {
+      best = s;
+      bestDistance = d;
+    }
+  }
+  return best;
+}
+
+struct Camera {
+  TextPosition at;
+  bool orthographic = false;
+  Number zoom, aspect, antialiasing, raydepth;
+  Triple center, viewdir, updir;
+};
+
+class TachyonReader {
+ public:
+  TachyonReader(std::string_view text, SceneEmitter& out, const std::atomic<bool>* cancel)
+      : in_(text, out),
+        out_(out),
+        textures_(in_, out),
+        cancel_(cancel),
+        geometry_(in_, out, textures_, transVmd_) {}
+
+  void read() {
+    try {
+      beginScene();
+    } catch (const SyntaxError&) {
+      return;
+    }
+    std::size_t statements = 0;
+    while (!ended_) {
+      const std::optional<Token> t = in_.tokens().next();
+      if (!t) {
+        out_.error(in_.tokens().end(), "the file ends without END_SCENE");
+        break;
+      }
+      if (++statements % kStatementsPerPoll == 0) throwIfCancelled(cancel_);
+      try {
+        statement(*t);
+      } catch (const SyntaxError&) {
+        skipToNextStatement();
+      }
+    }
+    geometry_.emitMeshes();
+    emitSettings();
+  }
+
+ private:
+  void beginScene() {
+    const std::optional<Token> begin = in_.tokens().next();
+    if (!begin || upper(begin->text) != "BEGIN_SCENE") {
+      const TextPosition at = begin ? begin->at : in_.tokens().end();
+      out_.error(at, fmt::format("expected BEGIN_SCENE, got {}; a Tachyon scene starts with "
+                                 "BEGIN_SCENE and RESOLUTION",
+                                 begin ? quoteForMessage(begin->text) : "the end of the file"));
+      throw SyntaxError{};
+    }
+    scene_ = *begin;
+    in_.keyword(*begin, "RESOLUTION");
+    resolution_[0] = in_.number(*begin, "x resolution");
+    resolution_[1] = in_.number(*begin, "y resolution");
+  }
+
+  void statement(const Token& t) {
+    const std::string word = upper(t.text);
+    if (word == "END_SCENE") {
+      ended_ = true;
+    } else if (word == "CAMERA") {
+      camera(t);
+    } else if (word == "LIGHT" || word == "SPOTLIGHT") {
+      light(t, word == "SPOTLIGHT");
+    } else if (word == "DIRECTIONAL_LIGHT") {
+      directionalLight(t);
+    } else if (word == "BACKGROUND") {
+      background_ = in_.color(t, "background");
+      backgroundAt_ = t.at;
+    } else if (word == "FOG") {
+      fog(t);
+    } else if (word == "SHADER_MODE") {
+      shaderMode(t);
+    } else if (word == "TEXDEF") {
+      const Token name = in_.need(t, "a texture name");
+      const Texture texture = textures_.body(t, false);
+      textures_.define(std::string(name.text), texture, name.at, transVmd_);
+    } else if (word == "TEXALIAS") {
+      const Token alias = in_.need(t, "the alias name");
+      const Token original = in_.need(t, "the texture it names");
+      textures_.alias(std::string(alias.text), original);
+    } else if (word == "SPHERE" || word == "FCYLINDER" || word == "CYLINDER" || word == "RING" ||
+               word == "PLANE" || word == "BOX") {
+      geometry_.shape(t, word);
+    } else if (word == "TRI" || word == "STRI" || word == "VCSTRI") {
+      geometry_.triangle(t, word);
+    } else if (word == "VERTEXARRAY") {
+      geometry_.vertexArray(t);
+    } else if (std::find(kUnsupported.begin(), kUnsupported.end(), word) != kUnsupported.end()) {
+      out_.error(t.at, fmt::format("the Tachyon statement {} is not supported by glint (the "
+                                   "nearest supported statement is {})",
+                                   t.text, nearestSupported(word)));
+      throw SyntaxError{};
+    } else {
+      out_.error(t.at, fmt::format("unknown Tachyon statement {} (the nearest supported statement "
+                                   "is {})",
+                                   quoteForMessage(t.text), nearestSupported(word)));
+      throw SyntaxError{};
+    }
+  }
+
+  // After an error: on to the next statement keyword.
+  void skipToNextStatement() {
+    while (const std::optional<Token> t = in_.tokens().peek()) {
+      const std::string word = upper(t->text);
+      if (std::find(kSupported.begin(), kSupported.end(), word) != kSupported.end() ||
+          std::find(kUnsupported.begin(), kUnsupported.end(), word) != kUnsupported.end()) {
+        return;
+      }
+      in_.tokens().next();
+    }
+  }
+
+  // --- camera, shader mode, fog --------------------------------------------------------------
+
+  void camera(const Token& t) {
+    Camera c;
+    c.at = t.at;
+    Token next = in_.need(t, "PROJECTION or ZOOM");
+    if (upper(next.text) == "PROJECTION") {
+      const Token mode = in_.need(t, "a projection");
+      const std::string m = upper(mode.text);
+      if (m == "ORTHOGRAPHIC") {
+        c.orthographic = true;
+      } else if (m != "PERSPECTIVE") {
+        out_.error(mode.at, fmt::format("camera projection {} is not supported (glint reads "
+                                        "PERSPECTIVE and ORTHOGRAPHIC)",
+                                        quoteForMessage(mode.text)));
+        throw SyntaxError{};
+      }
+      next = in_.need(t, "ZOOM");
+    }
+    in_.expectWord(t, next, "ZOOM");
+    c.zoom = in_.number(t, "zoom");
+    in_.keyword(t, "ASPECTRATIO");
+    c.aspect = in_.number(t, "aspect ratio");
+    in_.keyword(t, "ANTIALIASING");
+    c.antialiasing = in_.number(t, "antialiasing");
+    in_.keyword(t, "RAYDEPTH");
+    c.raydepth = in_.number(t, "ray depth");
+    in_.keyword(t, "CENTER");
+    c.center = in_.point(t, "camera center");
+    in_.keyword(t, "VIEWDIR");
+    c.viewdir = in_.point(t, "view direction");
+    in_.keyword(t, "UPDIR");
+    c.updir = in_.point(t, "up direction");
+    const Token end = in_.need(t, "END_CAMERA");
+    if (upper(end.text) == "FRUSTUM") {
+      out_.error(end.at, "the camera's FRUSTUM is not supported by glint");
+      throw SyntaxError{};
+    }
+    in_.expectWord(t, end, "END_CAMERA");
+    for (const Number* n : {&c.zoom, &c.aspect}) {
+      if (!(n->value > 0)) {
+        out_.error(n->at, fmt::format("camera: {} must be > 0, got {}",
+                                      n == &c.zoom ? "ZOOM" : "ASPECTRATIO", n->text));
+        return;
+      }
+    }
+    if (!(c.antialiasing.value >= 0 && c.antialiasing.value == std::floor(c.antialiasing.value))) {
+      out_.error(c.antialiasing.at, fmt::format("camera: ANTIALIASING must be a whole number >= 0, "
+                                                "got {}",
+                                                c.antialiasing.text));
+      return;
+    }
+    camera_ = c;
+  }
+
+  void shaderMode(const Token& t) {
+    const Token mode = in_.need(t, "FULL, MEDIUM, LOW or LOWEST");
+    const std::string m = upper(mode.text);
+    if (m != "FULL" && m != "MEDIUM" && m != "LOW" && m != "LOWEST") {
+      out_.error(mode.at, fmt::format("SHADER_MODE: expected FULL, MEDIUM, LOW or LOWEST, got {}",
+                                      quoteForMessage(mode.text)));
+      throw SyntaxError{};
+    }
+    if (m != "FULL") {
+      out_.warning(mode.at, fmt::format("SHADER_MODE {}: glint shades every scene fully (with "
+                                        "shadows, reflections and transparency)",
+                                        mode.text));
+    }
+    for (;;) {
+      const Token option = in_.need(t, "END_SHADER_MODE");
+      const std::string o = upper(option.text);
+      if (o == "END_SHADER_MODE") return;
+      if (o == "TRANS_VMD") {
+        transVmd_ = true;
+      } else if (o == "TRANS_ORIG") {
+        transVmd_ = false;
+      } else if (o == "FOG_VMD") {
+        fogVmd_ = true;
+      } else if (o == "SHADOW_FILTER_ON") {
+      } else if (o == "SHADOW_FILTER_OFF" || o == "TRANS_MAX_SURFACES") {
+        if (o == "TRANS_MAX_SURFACES") in_.number(t, "surfaces");
+        out_.warning(option.at, fmt::format("SHADER_MODE {} is ignored: glint filters shadows "
+                                            "through every transparent surface",
+                                            option.text));
+      } else {
+        out_.error(option.at, fmt::format("SHADER_MODE option {} is not supported by glint",
+                                          quoteForMessage(option.text)));
+        throw SyntaxError{};
+      }
+    }
+  }
+
+  void fog(const Token& t) {
+    const Token mode = in_.need(t, "LINEAR, EXP, EXP2 or OFF");
+    const std::string m = upper(mode.text);
+    if (m != "LINEAR" && m != "EXP" && m != "EXP2" && m != "OFF") {
+      out_.error(mode.at, fmt::format("FOG: expected LINEAR, EXP, EXP2 or OFF, got {}",
+                                      quoteForMessage(mode.text)));
+      throw SyntaxError{};
+    }
+    Fog f;
+    f.at = t.at;
+    f.mode = m;
+    f.modeAt = mode.at;
+    in_.keyword(t, "START");
+    f.start = in_.number(t, "start");
+    in_.keyword(t, "END");
+    f.end = in_.number(t, "end");
+    in_.keyword(t, "DENSITY");
+    f.density = in_.number(t, "density");
+    in_.keyword(t, "COLOR");
+    f.color = in_.color(t, "fog color");
+    if (m == "OFF") {
+      fog_.reset();
+    } else {
+      fog_ = f;
+    }
+  }
+
+  // --- lights --------------------------------------------------------------------------------
+
+  void light(const Token& t, bool spot) {
+    in_.keyword(t, "CENTER");
+    const Triple center = in_.point(t, "light center");
+    in_.keyword(t, "RAD");
+    const Number radius = in_.number(t, "light radius");
+    std::optional<Triple> direction;
+    Number start, end;
+    if (spot) {
+      in_.keyword(t, "DIRECTION");
+      direction = in_.point(t, "spot direction");
+      in_.keyword(t, "FALLOFF_START");
+      start = in_.number(t, "falloff start, degrees");
+      in_.keyword(t, "FALLOFF_END");
+      end = in_.number(t, "falloff end, degrees");
+    }
+    std::optional<std::array<Number, 3>> attenuation;
+    Token next = in_.need(t, "COLOR or ATTENUATION");
+    if (upper(next.text) == "ATTENUATION") {
+      std::array<Number, 3> k;
+      in_.keyword(t, "CONSTANT");
+      k[0] = in_.number(t, "constant attenuation");
+      in_.keyword(t, "LINEAR");
+      k[1] = in_.number(t, "linear attenuation");
+      in_.keyword(t, "QUADRATIC");
+      k[2] = in_.number(t, "quadratic attenuation");
+      attenuation = k;
+      next = in_.need(t, "COLOR");
+    }
+    in_.expectWord(t, next, "COLOR");
+    const Triple color = in_.color(t, "light color");
+    if (radius.value > 0) {
+      out_.warning(radius.at,
+                   "the light's sphere (RAD > 0) is not drawn: glint's lights are "
+                   "invisible points");
+    }
+    const ValueId map = out_.nextId();
+    out_.openMap(t.at);
+    const ValueId type = out_.entry("type", spot ? "spot" : "point", t.at);
+    in_.emit("position", center);
+    if (spot) {
+      in_.emit("direction", *direction);
+      in_.emit("falloff_start", start);
+      in_.emit("falloff_end", end);
+    }
+    if (attenuation) {
+      out_.key("attenuation", (*attenuation)[0].at);
+      out_.openList((*attenuation)[0].at);
+      for (const Number& k : *attenuation) out_.scalar(k.text, k.at);
+      out_.close();
+    }
+    in_.emit("color", color);
+    out_.close();
+    out_.addEntity(EntityKind::LightEntity, map, type);
+  }
+
+  void directionalLight(const Token& t) {
+    in_.keyword(t, "DIRECTION");
+    const Triple direction = in_.point(t, "light direction");
+    in_.keyword(t, "COLOR");
+    const Triple color = in_.color(t, "light color");
+    const ValueId map = out_.nextId();
+    out_.openMap(t.at);
+    const ValueId type = out_.entry("type", "directional", t.at);
+    in_.emit("direction", direction);
+    in_.emit("color", color);
+    out_.close();
+    out_.addEntity(EntityKind::LightEntity, map, type);
+  }
+
+  // --- the scene-wide entities, once everything is read ---------------------------------------
+
+  void emitSettings() {
+    const TextPosition at = scene_.at;
+    const Camera c = camera_.value_or(Camera{});
+    ValueId map = out_.nextId();
+    out_.openMap(camera_ ? c.at : at);
+    if (camera_) {
+      in_.emit("position", c.center);
+      in_.emit("direction", c.viewdir);
+      in_.emit("up", c.updir);
+    } else {
+      // Tachyon's default camera: at the origin looking along +z (−z mirrored), +y up.
+      const double position[3] = {0, 0, 0};
+      const double direction[3] = {0, 0, 1};
+      out_.computedTriple("position", position, at);
+      out_.computedTriple("direction", direction, at);
+    }
+    if (c.orthographic) out_.entry("projection", "orthographic", c.at);
+    const double zoom = camera_ ? c.zoom.value : 1;
+    const double aspect = camera_ ? c.aspect.value : 1;
+    const double w = resolution_[0].value, h = resolution_[1].value;
+    const TextPosition planeAt = camera_ ? c.zoom.at : at;
+    out_.key("view_plane", planeAt);
+    out_.openMap(planeAt);
+    out_.entry("width", numberText(h > 0 ? (w / h) / aspect / zoom : 1), planeAt);
+    out_.entry("height", numberText(1 / zoom), planeAt);
+    if (!c.orthographic) out_.entry("distance", "1", planeAt);
+    out_.close();
+    out_.close();
+    out_.addEntity(EntityKind::CameraEntity, map);
+
+    map = out_.nextId();
+    out_.openMap(resolution_[0].at);
+    in_.emit("width", resolution_[0]);
+    in_.emit("height", resolution_[1]);
+    out_.entry("samples", camera_ ? numberText(c.antialiasing.value + 1) : std::string("1"),
+               camera_ ? c.antialiasing.at : at);
+    out_.entry("encoding", "linear", at);
+    out_.close();
+    out_.addEntity(EntityKind::ImageEntity, map);
+
+    map = out_.nextId();
+    out_.openMap(camera_ ? c.raydepth.at : at);
+    if (camera_) in_.emit("max_depth", c.raydepth);
+    out_.entry("min_weight", "0", at);
+    out_.close();
+    out_.addEntity(EntityKind::RenderEntity, map);
+
+    // A texture's AMBIENT is its own ambient term: glint's ka under white ambient light 1.
+    map = out_.nextId();
+    out_.openMap(at);
+    out_.entry("intensity", "1", at);
+    out_.close();
+    out_.addEntity(EntityKind::AmbientEntity, map);
+
+    if (background_) {
+      map = out_.nextId();
+      out_.openList(backgroundAt_);
+      for (const Number& n : background_->n) out_.scalar(n.text, n.at);
+      out_.close();
+      out_.addEntity(EntityKind::BackgroundEntity, map);
+    }
+    if (fog_) {
+      const Fog& f = *fog_;
+      map = out_.nextId();
+      out_.openMap(f.at);
+      std::string mode = f.mode;
+      for (char& ch : mode) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+      out_.entry("type", mode, f.modeAt);
+      in_.emit("start", f.start);
+      in_.emit(f.mode == "LINEAR" ? "end" : "density", f.mode == "LINEAR" ? f.end : f.density);
+      in_.emit("color", f.color);
+      if (fogVmd_) out_.entry("distance", "depth", f.at);
+      out_.close();
+      out_.addEntity(EntityKind::FogEntity, map);
+    }
+  }
+
+  Input in_;
+  SceneEmitter& out_;
+  Textures textures_;
+  const std::atomic<bool>* cancel_;
+  Token scene_;
+  std::array<Number, 2> resolution_;
+  bool ended_ = false;
+  bool transVmd_ = false;
+  bool fogVmd_ = false;
+  std::optional<Camera> camera_;
+  std::optional<Triple> background_;
+  TextPosition backgroundAt_;
+  struct Fog {
+    TextPosition at, modeAt;
+    std::string mode;
+    Number start, end, density;
+    Triple color;
+  };
+  std::optional<Fog> fog_;
+  Geometry geometry_;
+};
+
+ParseResult parse(std::string_view text, SceneDescription scene, const std::atomic<bool>* cancel) {
+  Diagnostics sink;
+  {
+    SceneEmitter out(scene, sink);
+    TachyonReader(text, out, cancel).read();
+  }
+  ParseResult result;
+  scene.complete = !sink.hasErrors();
+  result.description = std::move(scene);
+  result.diagnostics = sink.take();
+  return result;
+}
+
+}  // namespace
+
+ParseResult parseTachyon(std::string_view text, const std::string& file,
+                         const std::filesystem::path& baseDirectory,
+                         const std::atomic<bool>* cancel) {
+  SceneDescription scene = sceneWithFile(file, baseDirectory);
+  scene.files[0]->bytes = text.size();
+  return parse(text, std::move(scene), cancel);
+}
+
+ParseResult readTachyonFile(const std::filesystem::path& path, const std::string& name,
+                            const std::atomic<bool>* cancel) {
+  std::filesystem::path base = path.parent_path();
+  if (base.empty()) base = ".";
+  SceneDescription scene = sceneWithFile(name, base);
+  const std::string text = readWholeSceneFile(path, name, *scene.files[0]);
+  return parse(text, std::move(scene), cancel);
+}
+
+}  // namespace glint

@@ -1,0 +1,235 @@
+// The Tachyon reader (tachyon_reader.h): every supported statement as entities, the mirror in x,
+// textures as materials, and its errors naming the statement, its place and the nearest supported
+// one.
+#include "glint/readers/tachyon_reader.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <variant>
+
+#include "glint/factories/scene_loader.h"
+#include "glint/scene/texture.h"
+
+namespace glint {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Every supported statement, in the forms VMD writes (mixed case) and the manual lists.
+constexpr const char* kEveryStatement = R"(# VMD-like
+Begin_Scene
+Resolution 64 48
+Shader_Mode Full
+  Trans_VMD
+  Fog_VMD
+End_Shader_Mode
+Camera
+  Projection Perspective
+  Zoom 0.5
+  Aspectratio 1
+  Antialiasing 3
+  Raydepth 6
+  Center 1 0 -10
+  Viewdir 0 0 1
+  Updir 0 1 0
+End_Camera
+Directional_Light Direction 0.1 -0.1 1 Color 1 1 1
+Light Center 4 5 -6 Rad 0 Attenuation Constant 1 Linear 0.1 Quadratic 0 Color 0.5 0.5 0.5
+Spotlight Center 0 5 0 Rad 0 Direction 0 -1 0 Falloff_Start 20 Falloff_End 40 Color 1 1 0.8
+Background 0.1 0.1 0.2
+Fog Exp2 Start 0 End 30 Density 0.05 Color 0.1 0.1 0.2
+Texdef txt001 Ambient 0.1 Diffuse 0.65 Specular 0.2 Opacity 1
+  Phong Plastic 0.5 Phong_size 40 Color 1 0 0 TexFunc 0
+Texdef glass Ambient 0 Diffuse 0.3 Specular 0 Opacity 0.5
+  Phong Metal 0.4 Phong_size 20 Color 0 0 1 TexFunc 0
+TexAlias red txt001
+Sphere Center 2 0 0 Rad 1 red
+FCylinder Base 0 0 0 Apex 0 2 0 Rad 0.2 txt001
+Cylinder Center 5 0 5 Axis 0 1 0 Rad 0.5 glass
+Ring Center 0 -1 0 Normal 0 1 0 Inner 0.5 Outer 1 txt001
+Plane Center 0 -2 0 Normal 0 1 0 Texture Ambient 0.1 Diffuse 0.9 Specular 0 Opacity 1 Color 1 1 1 TexFunc 0
+Box Min -1 -1 -1 Max 0 0 0 glass
+Tri V0 0 0 0 V1 1 0 0 V2 0 1 0 txt001
+STri V0 0 0 1 V1 1 0 1 V2 0 1 1 N0 0 0 1 N1 0 0 1 N2 0 0 1 txt001
+VCSTri V0 0 0 2 V1 1 0 2 V2 0 1 2 N0 0 0 1 N1 0 0 1 N2 0 0 1 C0 1 0 0 C1 0 1 0 C2 0 0 1
+  Ambient 0.1 Diffuse 0.9 Specular 0 Opacity 1 VCST
+VertexArray Numverts 4
+Coords 0 0 3 1 0 3 1 1 3 0 1 3
+Normals 0 0 1 0 0 1 0 0 1 0 0 1
+Colors 1 0 0 0 1 0 0 0 1 1 1 1
+Texture Ambient 0.1 Diffuse 0.9 Specular 0 Opacity 1 Color 1 1 1 TexFunc 0
+TriStrip 4 0 1 3 2
+TriMesh 1 0 1 2
+End_VertexArray
+End_Scene
+)";
+
+std::string firstError(const ParseResult& r) {
+  for (const Diagnostic& d : r.diagnostics) {
+    if (d.severity == Diagnostic::Severity::Error) return d.format();
+  }
+  return "<no error>";
+}
+
+const Entity& nth(const ParseResult& r, EntityKind kind, std::size_t n) {
+  for (const Entity& e : r.description.entities) {
+    if (e.kind == kind && n-- == 0) return e;
+  }
+  throw std::logic_error("no such entity");
+}
+
+std::string item(const ParseResult& r, const Entity& e, std::string_view key, std::size_t i) {
+  const ValueTree& t = r.description.files[0]->values;
+  return std::string(t.scalar(t.item(r.description.parameter(e, key), i)));
+}
+
+TEST(TachyonReader, EveryStatementBecomesEntitiesAndBuilds) {
+  const ParseResult r = parseTachyon(kEveryStatement, "every.dat");
+  ASSERT_FALSE(r.hasErrors()) << firstError(r);
+  const SceneDescription& d = r.description;
+  EXPECT_EQ(d.count(EntityKind::LightEntity), 3u);
+  EXPECT_EQ(d.count(EntityKind::FogEntity), 1u);
+  EXPECT_EQ(d.count(EntityKind::AmbientEntity), 1u);
+  // sphere, cone, tube, disk, plane, box, then the meshes: flat, smooth, vertex-coloured (the
+  // VCSTRI and the vertex array share a material and their kinds of data).
+  EXPECT_EQ(d.count(EntityKind::ObjectEntity), 9u);
+
+  // Mirrored in x: the camera's centre and the sphere's centre.
+  const Entity& camera = nth(r, EntityKind::CameraEntity, 0);
+  EXPECT_EQ(item(r, camera, "position", 0), "-1");
+  const Entity& sphere = nth(r, EntityKind::ObjectEntity, 0);
+  EXPECT_EQ(item(r, sphere, "center", 0), "-2");
+  EXPECT_EQ(d.text(sphere, d.parameter(sphere, "material")), "txt001");
+  // The box's x extent runs from −0 to 1 once mirrored.
+  const Entity& box = nth(r, EntityKind::ObjectEntity, 5);
+  EXPECT_EQ(item(r, box, "min", 0), "0");
+  EXPECT_EQ(item(r, box, "max", 0), "1");
+
+  // txt001 under TRANS_VMD (opacity 1: unscaled): kd = 0.65·red, ka = 0.1·red, kr = 0.2,
+  // plastic highlight 0.5 (white), shininess 40.
+  const Entity& txt = nth(r, EntityKind::MaterialEntity, 0);
+  EXPECT_EQ(d.text(txt, txt.name), "txt001");
+  EXPECT_EQ(item(r, txt, "kd", 0), "0.65");
+  EXPECT_EQ(item(r, txt, "ka", 0), "0.1");
+  EXPECT_EQ(item(r, txt, "ks", 1), "0.5");
+  // glass: opacity 0.5 under TRANS_VMD scales its own terms by 0.5; kt = 0.5; metal highlight.
+  const Entity& glass = nth(r, EntityKind::MaterialEntity, 1);
+  EXPECT_EQ(item(r, glass, "kd", 2), "0.15");
+  EXPECT_EQ(item(r, glass, "ks", 0), "0");
+  EXPECT_EQ(item(r, glass, "ks", 2), "0.2");
+  EXPECT_EQ(d.text(glass, d.parameter(glass, "kt")), "0.5");
+
+  // The image: antialiasing 3 → 4 samples; the view plane 1/zoom high.
+  const Entity& image = nth(r, EntityKind::ImageEntity, 0);
+  EXPECT_EQ(d.text(image, d.parameter(image, "samples")), "4");
+  const Entity& fog = nth(r, EntityKind::FogEntity, 0);
+  EXPECT_EQ(d.text(fog, d.parameter(fog, "distance")), "depth");
+
+  const LoadedScene loaded = buildDescribedScene(r);
+  ASSERT_EQ(loaded.parts.meshes.size(), 3u);
+  EXPECT_FALSE(loaded.parts.meshes[2].colors.empty());
+  EXPECT_EQ(loaded.parts.meshes[2].triangleCount(), 4u);  // 1 VCSTRI + 2 strip + 1 mesh
+  EXPECT_TRUE(loaded.parts.fog.has_value());
+  EXPECT_TRUE(loaded.parts.camera.viewPlaneHeight == 2);
+}
+
+// Tachyon's checker_texture at a point q of its own (left-handed) space: per axis
+// round(3·|q − centre|), odd sum orange (1, 0.2, 0), even blue (0, 0.2, 1).
+Color tachyonChecker(const Vec3& q, const Vec3& centre) {
+  long sum = 0;
+  for (const double d : {q.x - centre.x, q.y - centre.y, q.z - centre.z}) {
+    sum += static_cast<long>(std::abs(d) * 3 + 0.5) % 2;
+  }
+  return sum % 2 == 1 ? Color(1, 0.2, 0) : Color(0, 0.2, 1);
+}
+
+TEST(TachyonReader, Texfunc1IsTachyonsCheckerExactly) {
+  const ParseResult r = parseTachyon(
+      "BEGIN_SCENE RESOLUTION 8 8\n"
+      "PLANE CENTER 0 -1 0 NORMAL 0 1 0 TEXTURE AMBIENT 0.1 DIFFUSE 0.5 SPECULAR 0 OPACITY 1 "
+      "COLOR 1 1 1 TEXFUNC 1 CENTER 0.3 -1 0.2 ROTATE 0 0 0 SCALE 1 1 1\nEND_SCENE\n",
+      "checker.dat");
+  ASSERT_FALSE(r.hasErrors()) << firstError(r);
+  const LoadedScene loaded = buildDescribedScene(r);
+  ASSERT_EQ(loaded.parts.primitives.size(), 1u);
+  const Material& m = loaded.parts.materials.at(loaded.parts.primitives[0].materialIndex());
+  ASSERT_NE(m.textures, kUntextured);
+  const MaterialTextures& bound = loaded.parts.materialTextures.at(m.textures);
+  ASSERT_NE(bound.kd, kNoTexture);
+  ASSERT_NE(bound.ka, kNoTexture);
+  const Vec3 centre{0.3, -1, 0.2};
+  int compared = 0;
+  // Points of the plane y = −1 in glint's space (x mirrored from Tachyon's), off the cell edges.
+  for (double x = -2.04; x < 2; x += 0.0913) {
+    for (double z = -2.01; z < 2; z += 0.1071) {
+      const Vec3 tachyonPoint{-x, -1, z};
+      const Color expected = tachyonChecker(tachyonPoint, centre);
+      const TextureLookup at{Point3{x, -1, z}, {}, {}, {}};
+      const Color kd = m.kd * evaluate(loaded.parts.textures.at(bound.kd), at);
+      const Color ka = m.ka * evaluate(loaded.parts.textures.at(bound.ka), at);
+      ASSERT_NEAR(kd.r, 0.5 * expected.r, 1e-12) << x << " " << z;
+      ASSERT_NEAR(kd.b, 0.5 * expected.b, 1e-12) << x << " " << z;
+      ASSERT_NEAR(ka.r, 0.1 * expected.r, 1e-12) << x << " " << z;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 1500);
+  // Marble and wood are glint's own patterns, with a warning saying so.
+  const ParseResult wood = parseTachyon(
+      "BEGIN_SCENE RESOLUTION 8 8\n"
+      "SPHERE CENTER 0 0 0 RAD 1 TEXTURE AMBIENT 0.1 DIFFUSE 0.5 SPECULAR 0 OPACITY 1 "
+      "COLOR 1 1 1 TEXFUNC 4 CENTER 0 0 0 ROTATE 0 0 0 SCALE 0.01 0.01 0.01\nEND_SCENE\n",
+      "wood.dat");
+  ASSERT_FALSE(wood.hasErrors()) << firstError(wood);
+  bool warned = false;
+  for (const Diagnostic& d : wood.diagnostics) {
+    warned = warned || d.message.find("TEXFUNC 4 (wood) is drawn with glint's wood pattern") == 0;
+  }
+  EXPECT_TRUE(warned);
+  const LoadedScene woodScene = buildDescribedScene(wood);
+  const Material& w = woodScene.parts.materials.at(woodScene.parts.primitives[0].materialIndex());
+  ASSERT_NE(w.textures, kUntextured);
+  const auto* rings = std::get_if<NoiseTexture>(
+      &woodScene.parts.textures.at(woodScene.parts.materialTextures.at(w.textures).kd));
+  ASSERT_NE(rings, nullptr);
+  EXPECT_EQ(rings->pattern, NoisePattern::Wood);
+  EXPECT_DOUBLE_EQ(rings->scale, 0.6);  // Tachyon's rings, 60 scale units apart
+}
+
+TEST(TachyonReader, UnsupportedStatementsNameTheNearestSupportedOne) {
+  const auto error = [](const std::string& body) {
+    return firstError(
+        parseTachyon("BEGIN_SCENE RESOLUTION 8 8\n" + body + "\nEND_SCENE\n", "bad.dat"));
+  };
+  EXPECT_EQ(error("SPHEREARRAY NUMSPHERES 1"),
+            "bad.dat:2:1: the Tachyon statement SPHEREARRAY is not supported by glint (the "
+            "nearest supported statement is SPHERE)");
+  EXPECT_EQ(error("Background_Gradient Sky_Sphere"),
+            "bad.dat:2:1: the Tachyon statement Background_Gradient is not supported by glint (the "
+            "nearest supported statement is BACKGROUND)");
+  EXPECT_EQ(error("SPHER CENTER 0 0 0 RAD 1 x"),
+            "bad.dat:2:1: unknown Tachyon statement 'SPHER' (the nearest supported statement is "
+            "SPHERE)");
+  EXPECT_EQ(error("SPHERE CENTER 0 0 0 RAD 1 TEXTURE AMBIENT 0 DIFFUSE 1 SPECULAR 0 OPACITY 1 "
+                  "COLOR 1 1 1 TEXFUNC 7 earth.ppm CENTER 0 0 0 ROTATE 0 0 0 SCALE 1 1 1"),
+            "bad.dat:2:96: TEXFUNC 7 (cylindrical image map) is not supported by glint; TEXFUNC 0 "
+            "(plain colour), 1 (3D checker), 3 (marble) and 4 (wood) are");
+  EXPECT_EQ(error("SPHERE CENTER 0 0 0 RAD 1 TEXTURE AMBIENT 0 DIFFUSE 1 SPECULAR 0 OPACITY 1 "
+                  "COLOR 1 1 1 TEXFUNC 1 CENTRE 0 0 0 ROTATE 0 0 0 SCALE 1 1 1"),
+            "bad.dat:2:98: SPHERE: expected CENTER, got 'CENTRE'");
+  EXPECT_EQ(error("SPHERE CENTER 0 0 0 RAD 1 nowhere"),
+            "bad.dat:2:27: SPHERE: undefined texture 'nowhere' (a TEXDEF name, or TEXTURE and its "
+            "definition)");
+  EXPECT_EQ(error("SPHERE CENTRE 0 0 0"), "bad.dat:2:8: SPHERE: expected CENTER, got 'CENTRE'");
+  EXPECT_EQ(firstError(parseTachyon("RESOLUTION 8 8", "a.dat")),
+            "a.dat:1:1: expected BEGIN_SCENE, got 'RESOLUTION'; a Tachyon scene starts with "
+            "BEGIN_SCENE and RESOLUTION");
+  EXPECT_THAT(firstError(parseTachyon("BEGIN_SCENE RESOLUTION 8 8 SPHERE", "a.dat")),
+              HasSubstr("the file ends inside SPHERE"));
+}
+
+}  // namespace
+}  // namespace glint

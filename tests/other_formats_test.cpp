@@ -1,0 +1,333 @@
+// Other renderers' scenes (DESIGN.md §13) rendered by glint and checked in closed form: an NFF and
+// a Tachyon scene's sphere (its silhouette and its colour: a light's direct term), the cameras'
+// field of view at the image edge, Tachyon's mirror and orthographic camera, fog, vertex colours
+// and spot falloff cones; then `glint convert` (the converted YAML renders the same bytes, with and
+// without PLY files) and the quick look at a mesh file.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+#include "glint/factories/quick_look.h"
+#include "glint/factories/scene_loader.h"
+#include "glint/job/scene_convert.h"
+#include "glint/readers/nff_reader.h"
+#include "glint/readers/tachyon_reader.h"
+#include "glint/render/renderer.h"
+#include "glint/writers/yaml_scene_writer.h"
+
+namespace glint {
+namespace {
+
+namespace fs = std::filesystem;
+
+Scene sceneOf(const ParseResult& parsed) { return Scene(buildDescribedScene(parsed).parts); }
+
+Film renderOf(const Scene& scene) {
+  RenderOptions options;
+  options.threads = 2;
+  return render(scene, options);
+}
+
+void expectColor(const Color& actual, const Color& expected, double tolerance = 1e-9) {
+  EXPECT_NEAR(actual.r, expected.r, tolerance);
+  EXPECT_NEAR(actual.g, expected.g, tolerance);
+  EXPECT_NEAR(actual.b, expected.b, tolerance);
+}
+
+// The distance from the centre of a sphere at which the line through `origin` along unit `d`
+// passes, and the nearer hit point when it hits.
+std::optional<Point3> sphereHit(const Point3& origin, const Vec3& d, const Point3& c, double r) {
+  const Vec3 f = origin - c;
+  const double b = dot(f, d);
+  const double disc = b * b - (dot(f, f) - r * r);
+  if (disc < 0) return std::nullopt;
+  return origin + d * (-b - std::sqrt(disc));
+}
+
+// An SPD-like scene: one sphere, two lights at the eye (one coloured), an opaque fill.
+constexpr const char* kNffSphere = R"(b 0.1 0.2 0.3
+v
+from 0 0 10
+at 0 0 0
+up 0 1 0
+angle 30
+hither 1
+resolution 65 65
+l 0 0 10
+l 0 0 10 0.5 0.25 1
+f 1 0.5 0.25 0.8 0 1 0 1
+s 0 0 0 2
+)";
+
+TEST(NffImage, SphereSilhouetteAndColourAreTheDirectTermsOfItsLights) {
+  const ParseResult parsed = parseNff(kNffSphere, "sphere.nff");
+  const Scene scene = sceneOf(parsed);
+  const Film film = renderOf(scene);
+  const Color kd{0.8, 0.4, 0.2};
+  // Each light has intensity 1/√2 (two lights); the second is coloured.
+  const Color lights = (Color(1) + Color{0.5, 0.25, 1}) / std::sqrt(2.0);
+  const Camera& camera = scene.camera();
+  int sphere = 0, background = 0;
+  for (int y = 0; y < 65; ++y) {
+    for (int x = 0; x < 65; ++x) {
+      const Ray ray = camera.generateRay(x, y);
+      const std::optional<Point3> p = sphereHit(ray.origin, ray.direction, {0, 0, 0}, 2);
+      // Leave out pixels whose ray grazes the silhouette.
+      const Vec3 f = ray.origin - Point3{0, 0, 0};
+      const double miss = length(f - ray.direction * dot(f, ray.direction)) - 2;
+      if (std::abs(miss) < 1e-6) continue;
+      if (!p) {
+        expectColor(film.at(x, y), {0.1, 0.2, 0.3}, 0);
+        ++background;
+        continue;
+      }
+      // kd·Σ I_L·|n·l| with both lights at the eye.
+      const Vec3 n = normalize(*p - Point3{0, 0, 0});
+      const Vec3 l = normalize(*p - Point3{0, 0, 10});
+      expectColor(film.at(x, y), kd * lights * std::abs(dot(n, l)));
+      ++sphere;
+    }
+  }
+  EXPECT_GT(sphere, 500);
+  EXPECT_GT(background, 1500);
+  // The centre pixel looks straight at the sphere: n·l = −1.
+  expectColor(film.at(32, 32), kd * lights);
+}
+
+TEST(NffImage, AngleSpansTheCentresOfTheEdgeRowsAndColumns) {
+  for (const auto& [columns, rows] : {std::pair{65, 65}, std::pair{80, 41}, std::pair{32, 96}}) {
+    const std::string text = fmt::format(
+        "v from 1 2 3 at 1 2 -7 up 0 1 0 angle 50 hither 1 resolution {} {}\n", columns, rows);
+    const Scene scene = sceneOf(parseNff(text, "fov.nff"));
+    const Camera& camera = scene.camera();
+    // The centres of the top and bottom rows lie 25° above and below the view direction (−z).
+    for (const int row : {0, rows - 1}) {
+      const Ray ray = camera.generateRay(columns / 2, row);
+      EXPECT_NEAR(std::abs(std::atan2(ray.direction.y, -ray.direction.z)) * 180 / std::numbers::pi,
+                  25, 1e-10)
+          << columns << "x" << rows;
+    }
+    // Square pixels: the horizontal pitch is the vertical one.
+    const Ray a = camera.generateRay(0, 0), b = camera.generateRay(1, 0),
+              c = camera.generateRay(0, 1);
+    EXPECT_NEAR(length(a.direction / -a.direction.z - b.direction / -b.direction.z),
+                length(a.direction / -a.direction.z - c.direction / -c.direction.z), 1e-12);
+  }
+}
+
+constexpr const char* kTachyonSphere = R"(BEGIN_SCENE
+RESOLUTION 64 64
+CAMERA ZOOM 1 ASPECTRATIO 1 ANTIALIASING 0 RAYDEPTH 4
+  CENTER 0 0 -10 VIEWDIR 0 0 1 UPDIR 0 1 0 END_CAMERA
+LIGHT CENTER 0 0 -10 RAD 0 COLOR 1 1 1
+BACKGROUND 0.1 0.2 0.3
+SPHERE CENTER 2 0 0 RAD 1 TEXTURE AMBIENT 0.1 DIFFUSE 0.8 SPECULAR 0 OPACITY 1
+  COLOR 1 0.5 0.25 TEXFUNC 0
+END_SCENE
+)";
+
+TEST(TachyonImage, SphereIsOnTheRightWithAmbientPlusDiffuseColour) {
+  const Scene scene = sceneOf(parseTachyon(kTachyonSphere, "sphere.dat"));
+  const Film film = renderOf(scene);
+  const Color color{1, 0.5, 0.25};
+  // Tachyon shows +x on the right looking along +z: the mirrored scene puts the sphere there.
+  double sumX = 0;
+  int count = 0;
+  const Camera& camera = scene.camera();
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      const Ray ray = camera.generateRay(x, y);
+      const std::optional<Point3> p = sphereHit(ray.origin, ray.direction, {-2, 0, 0}, 1);
+      if (!p) continue;
+      const Vec3 n = normalize(*p - Point3{-2, 0, 0});
+      const Vec3 l = normalize(*p - Point3{0, 0, -10});
+      // Tachyon: colour · (ambient + diffuse · n·L).
+      expectColor(film.at(x, y), color * (0.1 + 0.8 * std::abs(dot(n, l))), 1e-9);
+      sumX += x;
+      ++count;
+    }
+  }
+  ASSERT_GT(count, 20);
+  // 2/10 of the way out in a plane 1/zoom = 1 high at distance 1: 0.2·64 pixels right of centre.
+  EXPECT_NEAR(sumX / count, 31.5 + 0.2 * 64, 0.6);
+  // ZOOM 1: the top row's centre is atan(0.5·63/64) above the view direction.
+  const Ray top = camera.generateRay(32, 0);
+  EXPECT_NEAR(std::atan2(top.direction.y, top.direction.z), std::atan(0.5 * 63 / 64), 1e-9);
+}
+
+TEST(TachyonImage, OrthographicCameraShowsTrueSizes) {
+  std::string text = kTachyonSphere;
+  text.replace(text.find("CAMERA ZOOM 1"), 13, "CAMERA PROJECTION ORTHOGRAPHIC ZOOM 0.1");
+  const Scene scene = sceneOf(parseTachyon(text, "ortho.dat"));
+  ASSERT_TRUE(scene.camera().isOrthographic());
+  const Film film = renderOf(scene);
+  // A view plane 10 units high: the sphere of radius 1 is 6.4 pixels in radius, centred 12.8 px
+  // right of the centre; its pixels are those within that radius.
+  for (int x = 0; x < 64; ++x) {
+    const double offset = (x - 31.5) / 6.4;  // scene units from the centre line
+    const bool inside = std::abs(offset - 2) < 0.99;
+    const bool outside = std::abs(offset - 2) > 1.01;
+    if (inside) {
+      EXPECT_FALSE(film.at(x, 31) == Color(0.1, 0.2, 0.3)) << x;
+    }
+    if (outside) {
+      EXPECT_TRUE(film.at(x, 31) == Color(0.1, 0.2, 0.3)) << x;
+    }
+  }
+}
+
+TEST(FogImage, LinearFogBlendsByDistance) {
+  const std::string yaml = R"(camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 30}
+image: {width: 8, height: 8, encoding: linear}
+ambient: {intensity: 1}
+fog: {type: linear, start: 2, end: 12, color: [0, 0, 1]}
+objects:
+  - {type: plane, point: [0, 0, -6], normal: [0, 0, 1], material: {kd: 0, ka: [1, 1, 0]}}
+)";
+  const Scene scene(loadSceneFromString(yaml, "fog.yaml").parts);
+  const Film film = renderOf(scene);
+  const Ray ray = scene.camera().generateRay(3, 4);
+  const double t = 6 / -ray.direction.z;
+  const double f = (12 - t) / (12 - 2);
+  expectColor(film.at(3, 4), Color{1, 1, 0} * f + Color{0, 0, 1} * (1 - f));
+}
+
+TEST(VertexColorImage, ColoursInterpolateAndTintKdAndKa) {
+  const std::string yaml = R"(camera: {position: [0, 0, 5], direction: [0, 0, -1], fov: 40}
+image: {width: 9, height: 9, encoding: linear}
+ambient: {intensity: 1}
+objects:
+  - type: mesh
+    positions: [[-4, -4, 0], [4, -4, 0], [0, 4, 0]]
+    colors: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+    indices: [[0, 1, 2]]
+    material: {ka: 0.5}
+)";
+  const Scene scene(loadSceneFromString(yaml, "colors.yaml").parts);
+  const Film film = renderOf(scene);
+  // The centre pixel looks at (0, 0): barycentrics (0.25, 0.25, 0.5).
+  expectColor(film.at(4, 4), Color{0.25, 0.25, 0.5} * 0.5, 1e-12);
+}
+
+TEST(SpotFalloff, LinearInTheAngleBetweenTheCones) {
+  SpotLight spot;
+  spot.direction = {0, 0, -1};
+  spot.falloffStart = 20;
+  spot.falloffEnd = 40;
+  const auto at = [&](double degrees) {
+    const double a = degrees * std::numbers::pi / 180;
+    return spotFactor(spot, Vec3{std::sin(a), 0, -std::cos(a)});
+  };
+  EXPECT_DOUBLE_EQ(at(10), 1);
+  EXPECT_NEAR(at(30), 0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(at(45), 0);
+}
+
+// --- convert -------------------------------------------------------------------------------------
+
+class Convert : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = fs::temp_directory_path() / fmt::format("glint-convert-{}", ::getpid());
+    fs::create_directories(folder_);
+  }
+  void TearDown() override { fs::remove_all(folder_); }
+
+  fs::path write(const std::string& name, const std::string& text) {
+    const fs::path path = folder_ / name;
+    std::ofstream(path) << text;
+    return path;
+  }
+
+  // Renders FILE and its conversion to `name`.yaml; both images must be the same bytes.
+  void expectSameImage(const fs::path& file, std::size_t plyFiles) {
+    const fs::path output = folder_ / "out" / (file.stem().string() + ".yaml");
+    fs::create_directories(output.parent_path());
+    const ConvertResult result = convertScene(ConvertSpec{file, output, nullptr});
+    EXPECT_EQ(result.meshFiles.size(), plyFiles);
+    const Film original = renderOf(Scene(loadScene(file).parts));
+    const Film converted = renderOf(Scene(loadScene(output).parts));
+    ASSERT_EQ(original.width(), converted.width());
+    ASSERT_EQ(original.height(), converted.height());
+    int different = 0;
+    for (int y = 0; y < original.height(); ++y) {
+      for (int x = 0; x < original.width(); ++x)
+        different += original.at(x, y) == converted.at(x, y) ? 0 : 1;
+    }
+    EXPECT_EQ(different, 0) << file;
+  }
+
+  fs::path folder_;
+};
+
+TEST_F(Convert, NffRendersTheSameBytes) { expectSameImage(write("sphere.nff", kNffSphere), 0); }
+
+TEST_F(Convert, TachyonRendersTheSameBytes) {
+  expectSameImage(write("sphere.dat", kTachyonSphere), 0);
+}
+
+TEST_F(Convert, LargePolygonSetsGoToPlyFilesAndRenderTheSameBytes) {
+  // A 90×90 grid of quads (16,200 triangles) with patch normals, and a flat copy of it.
+  std::string nff =
+      "v from 0 -60 40 at 0 0 0 up 0 0 1 angle 40 hither 1 resolution 48 36\nl 10 -20 30\n"
+      "f 0.9 0.6 0.3 0.8 0.2 20 0 1\n";
+  for (const bool patch : {true, false}) {
+    for (int i = 0; i < 90; ++i) {
+      for (int j = 0; j < 90; ++j) {
+        nff += patch ? "pp 4\n" : "p 4\n";
+        for (const auto& [a, b] :
+             {std::pair{0, 0}, std::pair{1, 0}, std::pair{1, 1}, std::pair{0, 1}}) {
+          const double x = (i + a) * 0.4 - 18, y = (j + b) * 0.4 - 18;
+          const double z = patch ? 2 * std::sin(x * 0.3) * std::cos(y * 0.2) : -3 + 0.01 * x;
+          nff += fmt::format("{} {} {}", x, y, z);
+          if (patch)
+            nff += fmt::format(" {} {} 1", -0.6 * std::cos(x * 0.3) * std::cos(y * 0.2),
+                               0.4 * std::sin(x * 0.3) * std::sin(y * 0.2));
+          nff += "\n";
+        }
+      }
+    }
+  }
+  expectSameImage(write("grid.nff", nff), 2);
+}
+
+TEST_F(Convert, YamlWithAMeshFileKeepsItsPath) {
+  const fs::path mesh = fs::path(GLINT_SOURCE_DIR) / "scenes" / "mesh.yaml";
+  expectSameImage(mesh, 0);
+}
+
+TEST(QuickLook, FramesTheModelWithLightsAndGround) {
+  const fs::path model = fs::path(GLINT_SOURCE_DIR) / "scenes" / "meshes" / "torus_knot.obj";
+  const LoadedScene loaded = loadScene(model);
+  const SceneParts& parts = loaded.parts;
+  EXPECT_EQ(parts.lights.size(), 3u);
+  ASSERT_EQ(parts.primitives.size(), 1u);  // the ground plane
+  EXPECT_FALSE(parts.meshes.empty());
+  // The whole model is in view: every vertex projects inside the image.
+  const Scene scene{SceneParts(parts)};
+  const Camera& camera = scene.camera();
+  for (const TriangleMesh& mesh : scene.meshes()) {
+    for (const Point3& p : mesh.positions) {
+      const Vec3 d = p - camera.position();
+      const double depth = dot(d, camera.toward());
+      ASSERT_GT(depth, 0);
+      EXPECT_LT(std::abs(dot(d, camera.right()) / depth), camera.viewPlaneWidth() / 2);
+      EXPECT_LT(std::abs(dot(d, camera.up()) / depth), camera.viewPlaneHeight() / 2);
+    }
+  }
+  // From the front-right-above.
+  const Vec3 toCamera = camera.position() - scene.aggregate().bounds().centroid();
+  EXPECT_GT(toCamera.x, 0);
+  EXPECT_GT(toCamera.y, 0);
+  EXPECT_GT(toCamera.z, 0);
+}
+
+}  // namespace
+}  // namespace glint
