@@ -2,7 +2,9 @@
 // `#include "glint/<module>/..."` lines and checks each against the modules it may use:
 //   core ← geometry ← accel ← scene ← render;  readers (scene files as entities) use core only;
 //   mesh uses readers, scene and below; image (files of pictures) uses render's Film and below;
-//   factories turn entities into scene parts; job runs renders; cli only turns arguments into jobs.
+//   factories turn entities into scene parts; job runs renders; cluster spreads a job's render over
+//   MPI ranks (above job: it hooks the job's render step, and the job must not know MPI); cli only
+//   turns arguments into jobs.
 // Tests (*_test.cpp) may use anything.
 #include <gtest/gtest.h>
 
@@ -32,9 +34,12 @@ const std::map<std::string, std::set<std::string>>& allowedModules() {
       {"job",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
         "job"}},
+      {"cluster",
+       {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
+        "job", "cluster"}},
       {"cli",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
-        "job", "cli"}},
+        "job", "cluster", "cli"}},
   };
   return allowed;
 }
