@@ -4,6 +4,7 @@
 #include <pthread.h>
 #include <time.h>
 
+#include <algorithm>
 #include <climits>
 #include <stdexcept>
 #include <utility>
@@ -23,11 +24,13 @@ double threadCpuSeconds() {
 
 }  // namespace
 
+// A message on its way out or in.
 struct Link::Pending {
   std::string bytes;
-  MPI_Request request = MPI_REQUEST_NULL;
-  bool counted = false;  // queued by send(), so part of unsent_
+  MPI_Request request = MPI_REQUEST_NULL;  // MPI_REQUEST_NULL once complete
+  bool counted = false;                    // sent by send(), so part of unsent_
   int peer = 0;
+  int tag = 0;
 };
 
 Link::Link(std::vector<int> watched, LinkTiming timing) : timing_(timing) {
@@ -88,28 +91,38 @@ LinkCounters Link::counters() const {
 }
 
 void Link::run() {
-  std::list<Pending> pending;
+  std::list<Pending> sending;
+  std::list<Pending> receiving;  // in the order the messages were matched
   for (;;) {
     {
       const std::lock_guard<std::mutex> lock(mutex_);
       if (stopping_) break;
     }
-    const double start = threadCpuSeconds();
-    bool moved = sendQueued(pending);
-    moved = completeSends(pending) || moved;
-    moved = receiveArrived() || moved;
+    workStart_ = -1;
+    bool moved = sendQueued(sending);
+    moved = completeSends(sending) || moved;
+    moved = receiveArrived(receiving) || moved;
     watchPeers();
-    if (moved) {
-      const double took = threadCpuSeconds() - start;
+    if (workStart_ >= 0) {
+      const double took = threadCpuSeconds() - workStart_;
       const std::lock_guard<std::mutex> lock(mutex_);
       counters_.movingCpuSeconds += took;
-    } else {
-      std::this_thread::sleep_for(timing_.idlePoll);
+    }
+    if (!moved) {
+      // A message under way needs this side's MPI calls to progress (a tile above the shared
+      // memory's eager limit goes in fragments, each waiting for the other side's poll).
+      const bool underWay = !sending.empty() || !receiving.empty();
+      std::this_thread::sleep_for(underWay ? timing_.busyPoll : timing_.idlePoll);
     }
   }
-  // Abandoned sends: their peers are gone or the job is over; MPI frees the requests at exit.
-  for (Pending& p : pending)
-    if (p.request != MPI_REQUEST_NULL) MPI_Request_free(&p.request);
+  // Abandoned transfers: their peers are gone or the job is over; MPI frees the requests at exit.
+  for (std::list<Pending>* transfers : {&sending, &receiving})
+    for (Pending& p : *transfers)
+      if (p.request != MPI_REQUEST_NULL) MPI_Request_free(&p.request);
+}
+
+void Link::workStarts() {
+  if (workStart_ < 0) workStart_ = threadCpuSeconds();
 }
 
 bool Link::sendQueued(std::list<Pending>& pending) {
@@ -127,14 +140,15 @@ bool Link::sendQueued(std::list<Pending>& pending) {
     }
   }
   if (outgoing.empty()) return false;
+  workStarts();
   std::uint64_t bytes = 0;
   const Clock::time_point now = Clock::now();
   std::size_t failed = 0;
   for (Message& message : outgoing) {
     const bool counted = message.tag != Tag::Heartbeat;
     // A heartbeat made here is not counted in unsent_; every send() is.
-    Pending& p = pending.emplace_back(
-        Pending{std::move(message.bytes), MPI_REQUEST_NULL, counted, message.peer});
+    Pending& p = pending.emplace_back(Pending{std::move(message.bytes), MPI_REQUEST_NULL, counted,
+                                              message.peer, static_cast<int>(message.tag)});
     bytes += p.bytes.size();
     if (MPI_Isend(p.bytes.data(), static_cast<int>(p.bytes.size()), MPI_BYTE, message.peer,
                   static_cast<int>(message.tag), MPI_COMM_WORLD, &p.request) != MPI_SUCCESS) {
@@ -168,6 +182,7 @@ void Link::peerFailed(int peer) {
 }
 
 bool Link::completeSends(std::list<Pending>& pending) {
+  if (!pending.empty()) workStarts();
   std::size_t completed = 0;
   for (auto it = pending.begin(); it != pending.end();) {
     int done = 0;
@@ -193,32 +208,62 @@ bool Link::completeSends(std::list<Pending>& pending) {
   return true;
 }
 
-bool Link::receiveArrived() {
+bool Link::receiveArrived(std::list<Pending>& receiving) {
   bool any = false;
+  if (!receiving.empty()) workStarts();
+  // Every message that arrived is matched (MPI_Improbe) and received without blocking
+  // (MPI_Imrecv): a blocking receive of a fragmented message would spin until the sender's next
+  // poll. An error here (a broken connection) is left to the silence watch.
   for (;;) {
     int flag = 0;
+    MPI_Message handle = MPI_MESSAGE_NULL;
     MPI_Status status;
-    // An error here (a broken connection) is left to the silence watch.
-    if (MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &status) != MPI_SUCCESS ||
+    if (MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &handle, &status) !=
+            MPI_SUCCESS ||
         !flag)
       break;
     int count = 0;
     MPI_Get_count(&status, MPI_BYTE, &count);
-    std::string bytes(static_cast<std::size_t>(count), '\0');
-    if (MPI_Recv(bytes.data(), count, MPI_BYTE, status.MPI_SOURCE, status.MPI_TAG, MPI_COMM_WORLD,
-                 MPI_STATUS_IGNORE) != MPI_SUCCESS)
+    Pending& p =
+        receiving.emplace_back(Pending{std::string(static_cast<std::size_t>(count), '\0'),
+                                       MPI_REQUEST_NULL, false, status.MPI_SOURCE, status.MPI_TAG});
+    if (MPI_Imrecv(p.bytes.data(), count, MPI_BYTE, &handle, &p.request) != MPI_SUCCESS) {
+      receiving.pop_back();
       break;
+    }
     any = true;
-    const std::lock_guard<std::mutex> lock(mutex_);
-    counters_.bytesReceived += bytes.size();
-    ++counters_.messagesReceived;
-    if (const auto peer = watched_.find(status.MPI_SOURCE); peer != watched_.end())
-      peer->second.lastHeard = Clock::now();
-    if (status.MPI_TAG == static_cast<int>(Tag::Heartbeat)) continue;
-    inbox_.push_back(
-        Message{status.MPI_SOURCE, static_cast<Tag>(status.MPI_TAG), std::move(bytes)});
   }
-  if (any) arrived_.notify_all();
+  for (Pending& p : receiving) {
+    int done = 0;
+    if (p.request != MPI_REQUEST_NULL &&
+        MPI_Test(&p.request, &done, MPI_STATUS_IGNORE) == MPI_SUCCESS && done)
+      any = true;
+  }
+  // Delivered in the order they were matched from each peer (MPI's order), so a peer that stopped
+  // halfway through a message holds back only its own later messages.
+  bool delivered = false;
+  std::vector<int> held;  // peers with an earlier message still under way
+  for (auto it = receiving.begin(); it != receiving.end();) {
+    const bool waits = std::find(held.begin(), held.end(), it->peer) != held.end();
+    if (it->request != MPI_REQUEST_NULL || waits) {
+      if (!waits) held.push_back(it->peer);
+      ++it;
+      continue;
+    }
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      counters_.bytesReceived += it->bytes.size();
+      ++counters_.messagesReceived;
+      if (const auto peer = watched_.find(it->peer); peer != watched_.end())
+        peer->second.lastHeard = Clock::now();
+      if (it->tag != static_cast<int>(Tag::Heartbeat)) {
+        inbox_.push_back(Message{it->peer, static_cast<Tag>(it->tag), std::move(it->bytes)});
+        delivered = true;
+      }
+    }
+    it = receiving.erase(it);
+  }
+  if (delivered) arrived_.notify_all();
   return any;
 }
 

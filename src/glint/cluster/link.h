@@ -1,5 +1,6 @@
 // The one thread that makes MPI calls while a rank runs (MPI_THREAD_SERIALIZED): it sends queued
-// messages without blocking (MPI_Isend), takes in every message that arrives (MPI_Iprobe), sends
+// messages without blocking (MPI_Isend), takes in every message that arrives (MPI_Improbe and
+// MPI_Imrecv; a tile above the eager limit comes in fragments over several polls), sends
 // heartbeats, and reports a watched peer that stays silent longer than the timeout. Nothing in it
 // waits on MPI, so no rank can hang on a peer that died or stopped.
 #pragma once
@@ -27,8 +28,10 @@ struct LinkTiming {
   std::chrono::milliseconds heartbeat{1000};
   // A watched peer that sent nothing for this long is reported (Tag::Silent).
   std::chrono::milliseconds timeout{20000};
-  // The sleep between polls when nothing happened: the latency of a reply, and ~0.1% of a core.
-  std::chrono::microseconds idlePoll{500};
+  // The sleep between polls when nothing happened: the latency of a reply.
+  std::chrono::microseconds idlePoll{1000};
+  // ... while a message is under way, which this side's polls move along.
+  std::chrono::microseconds busyPoll{20};
 };
 
 struct Message {
@@ -43,7 +46,7 @@ struct LinkCounters {
   std::uint64_t messagesSent = 0;
   std::uint64_t messagesReceived = 0;
   double cpuSeconds = 0;        // the CPU time of the link's thread so far: every poll
-  double movingCpuSeconds = 0;  // of which in polls that sent or received a message
+  double movingCpuSeconds = 0;  // of which in polls with a message to send, under way or received
 };
 
 class Link {
@@ -79,9 +82,12 @@ class Link {
     Clock::time_point lastSent;
   };
   void run();
+  // Marks that this poll has work: its CPU time from here on counts as moving messages. An idle
+  // poll does not read the clock, so it stays cheap.
+  void workStarts();
   bool sendQueued(std::list<Pending>& pending);
   bool completeSends(std::list<Pending>& pending);
-  bool receiveArrived();
+  bool receiveArrived(std::list<Pending>& receiving);
   void watchPeers();
   // A send to `peer` failed: it is reported (Tag::Unreachable) and no longer watched.
   void peerFailed(int peer);
@@ -97,7 +103,8 @@ class Link {
   LinkCounters counters_;  // cpuSeconds filled in by counters()
   bool stopping_ = false;
   std::thread thread_;
-  clockid_t cpuClock_{};  // the thread's CPU-time clock
+  clockid_t cpuClock_{};   // the thread's CPU-time clock
+  double workStart_ = -1;  // the link thread's CPU time when this poll's work began; -1: none
   bool hasCpuClock_ = false;
 };
 
