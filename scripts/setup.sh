@@ -21,12 +21,13 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
 # What the Release build and the whole test suite need (CMakeLists.txt's find_package calls; the mesh
-# tests read Debian's assimp-testmodels).
+# tests read Debian's assimp-testmodels; OpenMPI for rendering across processes and its mpirun tests).
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libyaml-dev libpng-dev libjpeg62-turbo-dev libopenexr-dev libtbb-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libassimp-dev assimp-testmodels
+  libopenmpi-dev openmpi-bin
 )
 # clang with its compiler-rt (libFuzzer, ASan, UBSan runtimes) for the fuzz targets.
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)

@@ -3,7 +3,9 @@
 //   core ← geometry ← accel ← scene ← render;  readers (scene files as entities) use core only;
 //   mesh uses readers, scene and below; image (files of pictures) uses render's Film and below;
 //   factories turn entities into scene parts; writers write scene descriptions (readers' entities)
-//   as YAML; job runs renders and conversions; cli only turns arguments into jobs.
+//   as YAML; job runs renders and conversions; cluster spreads a job's render over MPI ranks
+//   (above job: it hooks the job's render step, and the job must not know MPI); cli only turns
+//   arguments into jobs.
 // Tests (*_test.cpp) may use anything.
 #include <gtest/gtest.h>
 
@@ -34,9 +36,12 @@ const std::map<std::string, std::set<std::string>>& allowedModules() {
       {"job",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
         "writers", "job"}},
+      {"cluster",
+       {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
+        "writers", "job", "cluster"}},
       {"cli",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
-        "writers", "job", "cli"}},
+        "writers", "job", "cluster", "cli"}},
   };
   return allowed;
 }

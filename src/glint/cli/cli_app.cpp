@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <new>
 #include <optional>
@@ -35,6 +36,11 @@
 #include "glint/render/renderer.h"
 #include "glint/scene/scene.h"
 #include "glint/scene/scene_limits.h"
+#ifdef GLINT_MPI
+#include "glint/cli/cluster_summary.h"
+#include "glint/cluster/cluster_render.h"
+#include "glint/cluster/launch.h"
+#endif
 
 namespace glint::cli {
 namespace {
@@ -387,10 +393,9 @@ int reportInterrupted(const RenderJobResult& result) {
   return SignalGuard::exitCodeFor(result.signal != 0 ? result.signal : SIGINT);
 }
 
-int runRender(const RenderArgs& args, SignalGuard& signals) {
-  RenderJobSpec spec = parseRequest(args);
-  spec.cancel = &signals.cancelFlag();
-  spec.cancelSignal = &signals.signalNumber();
+// Runs the job and prints its outcome; `moreStats` adds to --stats.
+int renderAndReport(RenderJobSpec spec, const RenderArgs& args, SignalGuard& signals,
+                    const std::function<std::string()>& moreStats) {
   const int threads = spec.threads > 0 ? spec.threads : tbb::info::default_concurrency();
 
   ProgressReporter progress(
@@ -424,8 +429,28 @@ int runRender(const RenderArgs& args, SignalGuard& signals) {
   if (!args.quiet) {
     printSummary(result);
     if (args.stats) printStats(result, threads);
+    if (args.stats && moreStats) emit(stderr, moreStats());
   }
   return kExitSuccess;
+}
+
+int runRender(const RenderArgs& args, SignalGuard& signals) {
+  RenderJobSpec spec = parseRequest(args);
+  spec.cancel = &signals.cancelFlag();
+  spec.cancelSignal = &signals.signalNumber();
+#ifdef GLINT_MPI
+  // Under mpirun or srun: one frame over every rank (docs/distributed.md); rank 0 reports.
+  if (cluster::launchedByMpi()) {
+    if (spec.threads == 0) spec.threads = cluster::defaultThreadsPerRank();
+    cluster::ClusterRender ranks;
+    if (!ranks.coordinates()) return ranks.serve(spec);
+    ranks.distribute(spec);
+    const int status = renderAndReport(std::move(spec), args, signals,
+                                       [&ranks] { return clusterStatsText(ranks.figures()); });
+    return ranks.finish(status);
+  }
+#endif
+  return renderAndReport(std::move(spec), args, signals, {});
 }
 
 // Argument-parser errors: CLI11's own message, minus its jargon, plus where to find help.

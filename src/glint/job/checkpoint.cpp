@@ -453,36 +453,39 @@ Checkpoint readCheckpoint(const fs::path& path, std::uint64_t memoryBudget) {
   return decodeCheckpoint(bytes, path.string(), memoryBudget);
 }
 
-std::optional<std::string> checkpointMismatch(const Checkpoint& checkpoint,
-                                              std::uint64_t fingerprint,
-                                              const CheckpointSettings& settings) {
-  const CheckpointSettings& was = checkpoint.settings;
-  const auto differs = [](const std::string& what, const std::string& then,
-                          const std::string& now) {
-    return fmt::format("it was made with {} {}, this render has {}", what, then, now);
-  };
-  if (was.width != settings.width || was.height != settings.height)
-    return differs("an image of", fmt::format("{}x{}", was.width, was.height),
-                   fmt::format("{}x{}", settings.width, settings.height));
-  if (was.region != settings.region)
-    return differs("region", describeRegion(was.region, was.width, was.height),
-                   describeRegion(settings.region, settings.width, settings.height));
-  if (was.samples != settings.samples)
-    return differs("samples per pixel", std::to_string(was.samples),
-                   std::to_string(settings.samples));
-  if (was.adaptiveMaxSamples != settings.adaptiveMaxSamples ||
-      was.adaptiveThreshold != settings.adaptiveThreshold) {
+std::optional<SettingDifference> firstSettingDifference(const CheckpointSettings& a,
+                                                        const CheckpointSettings& b) {
+  if (a.width != b.width || a.height != b.height)
+    return SettingDifference{"an image of", fmt::format("{}x{}", a.width, a.height),
+                             fmt::format("{}x{}", b.width, b.height)};
+  if (a.region != b.region)
+    return SettingDifference{"region", describeRegion(a.region, a.width, a.height),
+                             describeRegion(b.region, b.width, b.height)};
+  if (a.samples != b.samples)
+    return SettingDifference{"samples per pixel", std::to_string(a.samples),
+                             std::to_string(b.samples)};
+  if (a.adaptiveMaxSamples != b.adaptiveMaxSamples || a.adaptiveThreshold != b.adaptiveThreshold) {
     const auto adaptive = [](const CheckpointSettings& s) {
       return s.adaptiveMaxSamples == 0 ? std::string("off")
                                        : fmt::format("max_samples {}, threshold {:g}",
                                                      s.adaptiveMaxSamples, s.adaptiveThreshold);
     };
-    return differs("adaptive sampling", adaptive(was), adaptive(settings));
+    return SettingDifference{"adaptive sampling", adaptive(a), adaptive(b)};
   }
-  if (was.seed != settings.seed)
-    return differs("seed", std::to_string(was.seed), std::to_string(settings.seed));
-  if (was.tileSize != settings.tileSize)
-    return differs("tile size", std::to_string(was.tileSize), std::to_string(settings.tileSize));
+  if (a.seed != b.seed)
+    return SettingDifference{"seed", std::to_string(a.seed), std::to_string(b.seed)};
+  if (a.tileSize != b.tileSize)
+    return SettingDifference{"tile size", std::to_string(a.tileSize), std::to_string(b.tileSize)};
+  return std::nullopt;
+}
+
+std::optional<std::string> checkpointMismatch(const Checkpoint& checkpoint,
+                                              std::uint64_t fingerprint,
+                                              const CheckpointSettings& settings) {
+  if (const std::optional<SettingDifference> difference =
+          firstSettingDifference(checkpoint.settings, settings))
+    return fmt::format("it was made with {} {}, this render has {}", difference->what,
+                       difference->first, difference->second);
   if (checkpoint.fingerprint != fingerprint)
     return std::string(
         "the scene file, a mesh it loads or the glint version differs from the render that made "

@@ -114,6 +114,16 @@ void checkCheckpointFile(const std::filesystem::path& path);
 Checkpoint readCheckpoint(const std::filesystem::path& path,
                           std::uint64_t memoryBudget = defaultImageMemoryBudget());
 
+// The first setting in which two renders differ, worded for the user: what ("samples per pixel"),
+// then each render's value ("16", "4").
+struct SettingDifference {
+  std::string what;
+  std::string first;
+  std::string second;
+};
+std::optional<SettingDifference> firstSettingDifference(const CheckpointSettings& a,
+                                                        const CheckpointSettings& b);
+
 // Why `checkpoint` cannot continue a render with this fingerprint and these settings (naming the
 // first setting that differs, e.g. "it was made with --samples 16, this render has 4"), or
 // std::nullopt when it can.

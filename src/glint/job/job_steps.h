@@ -14,6 +14,10 @@ namespace glint {
 // loadScene; a SceneError becomes JobError(BadInput) carrying its diagnostics. Cancelled passes.
 LoadedScene loadSceneFile(const std::filesystem::path& file, const LoadOptions& options);
 
+// The scene file's bytes once more, for a fingerprint (checkpoints, the MPI ranks' comparison);
+// JobError(Failure) when it cannot be read again.
+std::string readSceneFileAgain(const std::filesystem::path& file);
+
 // The image limits and memory budget (DESIGN.md §7) for the film that will be allocated, checked
 // after the overrides changed the image: a request refused as too large is a bad request (exit 2),
 // refused before any allocation. `request` names what changed the image ("--width 70000"), empty

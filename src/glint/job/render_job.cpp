@@ -32,32 +32,6 @@ fs::path folderOf(const fs::path& path) {
   return path.parent_path().empty() ? fs::path(".") : path.parent_path();
 }
 
-// The scene file's bytes once more, for the checkpoint fingerprint. Only a regular file of at most
-// the loader's 256 MiB is read: a FIFO or a device given as the scene cannot be read twice.
-std::string readSceneAgain(const fs::path& file) {
-  const auto failure = [&file]() {
-    return JobError(JobFailure::Failure,
-                    fmt::format("cannot read '{}' again to fingerprint it", file.string()));
-  };
-  constexpr std::uint64_t kMaxSceneBytes = std::uint64_t{256} << 20;
-  const ReadableFile opened = openForReading(file);
-  bool ok = opened.refusal == FileRefusal::None && opened.size <= kMaxSceneBytes;
-  std::string bytes;
-  if (ok) bytes.reserve(static_cast<std::size_t>(opened.size));
-  char buffer[1 << 16];
-  while (ok && bytes.size() <= kMaxSceneBytes) {
-    const ssize_t n = ::read(opened.fd, buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      ok = n == 0;
-      break;
-    }
-    bytes.append(buffer, static_cast<std::size_t>(n));
-  }
-  if (!ok || bytes.size() > kMaxSceneBytes) throw failure();
-  return bytes;
-}
-
 // Scoped JobEvents::committing(true) … (false).
 class Committing {
  public:
@@ -172,7 +146,7 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
   if (checkpointPath) {
     const CheckpointSettings settings = checkpointSettingsFor(scene, region, options.tileSize);
     const std::uint64_t fingerprint =
-        renderFingerprint(readSceneAgain(spec.scene), scene, settings);
+        renderFingerprint(readSceneFileAgain(spec.scene), scene, settings);
     if (spec.resume) {
       try {
         resumed = readCheckpoint(*spec.resume, spec.memoryBudget);
@@ -231,7 +205,29 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
     };
   }
   if (events.renderStarting) events.renderStarting(tilesDone, tiles.size());
-  const Film film = render(scene, options, &result.stats);
+  Film film(scene.image().width, scene.image().height, region);
+  if (!spec.renderStep) {
+    renderInto(scene, options, film, &result.stats);
+  } else {
+    try {
+      spec.renderStep(scene, options, film, result.stats);
+    } catch (const JobError& error) {
+      // A failure keeps what was finished (a --resume renders only the rest); a refusal comes
+      // before any tile.
+      if (!collector || error.failure() == JobFailure::BadInput) throw;
+      std::string message = error.what();
+      try {
+        const Committing committing(events);
+        collector->save();
+        message += fmt::format("; {} of {} tiles are saved in '{}' (continue with --resume {})",
+                               collector->checkpoint().finishedTiles(), tiles.size(),
+                               checkpointPath->string(), checkpointPath->string());
+      } catch (const CheckpointError& saveError) {
+        message += fmt::format("; the checkpoint could not be saved: {}", saveError.what());
+      }
+      throw JobError(error.failure(), message);
+    }
+  }
   result.timings.render = result.stats.seconds;
   result.tilesResumed = result.stats.tilesResumed;
   for (std::size_t i = 0; i < tiles.size(); ++i)

@@ -53,6 +53,11 @@ struct RenderJobSpec {
   const std::atomic<bool>* cancel = nullptr;
   // The signal that set `cancel`, reported in the result (0 or null: not a signal). Not owned.
   const std::atomic<int>* cancelSignal = nullptr;
+  // Renders in place of renderInto, with the same contract: fills `film` (the region, resumed
+  // tiles included), calls the options' callbacks, sets the stats. The MPI coordinator (cluster/)
+  // spreads the tiles over processes here. A JobError it throws fails the job, after the finished
+  // tiles are saved to the checkpoint when it is a Failure. Empty: renderInto in this process.
+  std::function<void(const Scene&, const RenderOptions&, Film&, RenderStats&)> renderStep;
 };
 
 // A tile the render just finished.

@@ -1,11 +1,16 @@
 #include "glint/job/scene_check.h"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <cstdint>
 #include <new>
+#include <string>
 #include <utility>
 #include <variant>
 
+#include "glint/core/file_access.h"
 #include "glint/job/job_error.h"
 #include "glint/job/job_steps.h"
 
@@ -25,6 +30,32 @@ LoadedScene loadSceneFile(const std::filesystem::path& file, const LoadOptions& 
   } catch (const SceneError& error) {
     throw JobError(error);
   }
+}
+
+// Only a regular file of at most the loader's 256 MiB is read: a FIFO or a device given as the
+// scene cannot be read twice.
+std::string readSceneFileAgain(const std::filesystem::path& file) {
+  const auto failure = [&file]() {
+    return JobError(JobFailure::Failure,
+                    fmt::format("cannot read '{}' again to fingerprint it", file.string()));
+  };
+  constexpr std::uint64_t kMaxSceneBytes = std::uint64_t{256} << 20;
+  const ReadableFile opened = openForReading(file);
+  bool ok = opened.refusal == FileRefusal::None && opened.size <= kMaxSceneBytes;
+  std::string bytes;
+  if (ok) bytes.reserve(static_cast<std::size_t>(opened.size));
+  char buffer[1 << 16];
+  while (ok && bytes.size() <= kMaxSceneBytes) {
+    const ssize_t n = ::read(opened.fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      ok = n == 0;
+      break;
+    }
+    bytes.append(buffer, static_cast<std::size_t>(n));
+  }
+  if (!ok || bytes.size() > kMaxSceneBytes) throw failure();
+  return bytes;
 }
 
 void enforceImageLimits(const ImageSettings& image, const std::string& request,

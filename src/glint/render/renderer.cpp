@@ -6,6 +6,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <atomic>
@@ -662,11 +663,28 @@ std::vector<PixelRegion> tileRegions(const PixelRegion& region, int tileSize) {
 }
 
 Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats) {
+  Film film(scene.image().width, scene.image().height, validatedRegion(scene, options));
+  renderInto(scene, options, film, stats);
+  return film;
+}
+
+void renderInto(const Scene& scene, const RenderOptions& options, Film& film, RenderStats* stats) {
   const auto start = std::chrono::steady_clock::now();
   const PixelRegion region = validatedRegion(scene, options);
   if (options.threads < 0) throw std::invalid_argument("thread count must be ≥ 0");
+  if (film.region() != region || film.fullWidth() != scene.image().width ||
+      film.fullHeight() != scene.image().height)
+    throw std::invalid_argument("the film covers a different image or region than the render");
   const std::vector<PixelRegion> tiles = tileRegions(region, options.tileSize);
   const std::size_t tileCount = tiles.size();
+  if (options.tiles) {
+    std::vector<bool> listed(tileCount, false);
+    for (const std::size_t tile : *options.tiles) {
+      if (tile >= tileCount || listed[tile])
+        throw std::invalid_argument("the tiles to render must be distinct tile indices");
+      listed[tile] = true;
+    }
+  }
   const bool resuming = options.resumeFilm != nullptr && options.resumeTiles != nullptr;
   if (resuming && (options.resumeFilm->region() != region ||
                    options.resumeFilm->fullWidth() != scene.image().width ||
@@ -676,7 +694,6 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
   }
 
   const ImageSettings& image = scene.image();
-  Film film(image.width, image.height, region);
   SamplingPlan plan = samplingPlan(image);
   plan.drawsSamples = drawsSamples(scene, plan);
   const std::uint64_t seed = scene.render().seed;
@@ -760,14 +777,31 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
   };
 
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tileCount, 1),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t tile = range.begin(); tile != range.end(); ++tile) {
-                          renderTile(tile);
-                        }
-                      });
-  });
+  if (options.nextTile) {
+    // One puller per thread of the arena; a tile index out of range is the feed's bug.
+    arena.execute([&] {
+      tbb::task_group pullers;
+      for (int i = 0; i < arena.max_concurrency(); ++i) {
+        pullers.run([&] {
+          while (const std::optional<std::size_t> tile = options.nextTile()) {
+            if (*tile >= tileCount) throw std::invalid_argument("the tile feed gave no tile index");
+            renderTile(*tile);
+          }
+        });
+      }
+      pullers.wait();
+    });
+  } else {
+    const std::size_t count = options.tiles ? options.tiles->size() : tileCount;
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1),
+                        [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                            renderTile(options.tiles ? (*options.tiles)[i] : i);
+                          }
+                        });
+    });
+  }
 
   if (image.grid) paintGrid(film, *image.grid);
 
@@ -783,7 +817,6 @@ Film render(const Scene& scene, const RenderOptions& options, RenderStats* stats
     stats->seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
-  return film;
 }
 
 }  // namespace glint

@@ -63,6 +63,14 @@ struct RenderOptions {
   // run give the same bytes as an uninterrupted render.
   const Film* resumeFilm = nullptr;
   const std::vector<bool>* resumeTiles = nullptr;
+  // Render only these tiles (indices in tileRegions(region, tileSize), each at most once), taken
+  // roughly in this order; the others are neither rendered nor reported. Unset: every tile.
+  std::optional<std::vector<std::size_t>> tiles;
+  // A feed of tiles instead: every render thread asks it for its next tile when it is free, until
+  // it returns std::nullopt; it may block until one is known (another process hands them out).
+  // Called concurrently from the render threads. Takes precedence over `tiles`. When a thread's
+  // tile throws, render returns (and rethrows) only once the feed has ended for every thread.
+  std::function<std::optional<std::size_t>()> nextTile;
 };
 
 // Samples per pixel a render takes: every pixel takes `minimum`; with adaptive sampling a pixel
@@ -101,6 +109,12 @@ std::vector<PixelRegion> tileRegions(const PixelRegion& region, int tileSize);
 // Renders the scene (or its crop region) and applies the grid overlay. When cancelled, returns the
 // partial film with stats.cancelled = true.
 Film render(const Scene& scene, const RenderOptions& options = {}, RenderStats* stats = nullptr);
+
+// render() into the caller's film, which must cover the rendered region of this image: the pixels
+// of tiles it does not render stay as they are, and the caller may fill those (another process's
+// tiles) while it runs. The grid overlay is painted over the whole film when it returns.
+void renderInto(const Scene& scene, const RenderOptions& options, Film& film,
+                RenderStats* stats = nullptr);
 
 // Color seen along one ray (the seed's calcColor with recursion), for tests and tools. One value
 // of `rng` keys the sample stream (core/sampler.h, sequence index 0) of its glossy lobes and

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 #include <utility>
@@ -170,6 +171,52 @@ TEST(Renderer, TileSizeAndThreadCountDoNotChangeThePixels) {
           << "tile " << tileSize << ", threads " << threads;
     }
   }
+}
+
+// A subset of tiles, or tiles from a feed, into the caller's film: the rendered tiles have the
+// pixels of a whole render, the others keep what the film held; together they make the whole.
+TEST(Renderer, TileSubsetsAndTheFeedIntoOneFilmEqualTheWholeRender) {
+  SceneParts parts = litPlaneParts(21, 13);
+  parts.image.samples = 3;
+  const Scene scene(std::move(parts));
+  RenderOptions whole;
+  whole.tileSize = 4;
+  const Film expected = render(scene, whole);
+  const std::size_t tileCount = tileRegions(expected.region(), 4).size();
+
+  RenderOptions odd = whole;
+  odd.threads = 2;
+  odd.tiles.emplace();
+  for (std::size_t tile = tileCount; tile-- > 0;)
+    if (tile % 2 == 1) odd.tiles->push_back(tile);
+  std::vector<std::size_t> finished;
+  odd.tileFinished = [&finished](std::size_t tile, const Film&) { finished.push_back(tile); };
+  Film film(21, 13, expected.region());
+  const Color marker(7, 7, 7);
+  for (int y = 0; y < film.height(); ++y)
+    for (int x = 0; x < film.width(); ++x) film.at(x, y) = marker;
+  RenderStats stats;
+  renderInto(scene, odd, film, &stats);
+  EXPECT_EQ(finished.size(), odd.tiles->size());
+  EXPECT_FALSE(sameFilm(film, expected));  // the even tiles still hold the marker
+  EXPECT_TRUE(film.at(0, 0) == marker);
+
+  std::atomic<std::size_t> nextEven{0};
+  RenderOptions fed = whole;
+  fed.threads = 2;
+  fed.nextTile = [&nextEven, tileCount]() -> std::optional<std::size_t> {
+    const std::size_t tile = 2 * nextEven++;
+    if (tile >= tileCount) return std::nullopt;
+    return tile;
+  };
+  renderInto(scene, fed, film);
+  EXPECT_TRUE(sameFilm(film, expected));
+
+  RenderOptions twice = whole;
+  twice.tiles = std::vector<std::size_t>{1, 1};
+  EXPECT_THROW(renderInto(scene, twice, film), std::invalid_argument);
+  Film wrongRegion(21, 13, PixelRegion{0, 0, 20, 13});
+  EXPECT_THROW(renderInto(scene, whole, wrongRegion), std::invalid_argument);
 }
 
 TEST(Renderer, NonFiniteSamplesBecomeBlackAndAreCounted) {
