@@ -247,13 +247,16 @@ class Convert : public ::testing::Test {
   }
 
   // Renders FILE and its conversion to `name`.yaml; both images must be the same bytes.
-  void expectSameImage(const fs::path& file, std::size_t plyFiles) {
+  // `width`: render both at that width (0: the scene's own).
+  void expectSameImage(const fs::path& file, std::size_t plyFiles, int width = 0) {
     const fs::path output = folder_ / "out" / (file.stem().string() + ".yaml");
     fs::create_directories(output.parent_path());
     const ConvertResult result = convertScene(ConvertSpec{file, output, nullptr});
     EXPECT_EQ(result.meshFiles.size(), plyFiles);
-    const Film original = renderOf(Scene(loadScene(file).parts));
-    const Film converted = renderOf(Scene(loadScene(output).parts));
+    LoadOptions options;
+    if (width > 0) options.overrides.width = width;
+    const Film original = renderOf(Scene(loadScene(file, options).parts));
+    const Film converted = renderOf(Scene(loadScene(output, options).parts));
     ASSERT_EQ(original.width(), converted.width());
     ASSERT_EQ(original.height(), converted.height());
     int different = 0;
@@ -296,6 +299,31 @@ TEST_F(Convert, LargePolygonSetsGoToPlyFilesAndRenderTheSameBytes) {
     }
   }
   expectSameImage(write("grid.nff", nff), 2);
+}
+
+TEST_F(Convert, TexturesAndTheirImageFilesKeepTheirPaths) {
+  // Named and inline image textures, a normal map, an HDR sky; mesh files with their own maps.
+  for (const char* scene : {"textures.yaml", "textured-model.yaml"}) {
+    expectSameImage(fs::path(GLINT_SOURCE_DIR) / "scenes" / scene, 0, 96);
+  }
+  // Textures from an included file, whose image names start at that file's folder.
+  const fs::path chart = fs::path(GLINT_SOURCE_DIR) / "scenes" / "textures" / "uv_grid.png";
+  ASSERT_TRUE(fs::exists(chart)) << chart;
+  fs::create_directories(folder_ / "library" / "maps");
+  fs::copy_file(chart, folder_ / "library" / "maps" / "chart.png");
+  write("library/paints.yaml",
+        "textures:\n  chart: {type: image, file: maps/chart.png, filter: bilinear}\n"
+        "materials:\n  charted: {kd: chart}\n");
+  expectSameImage(
+      write("included.yaml",
+            "include: library/paints.yaml\n"
+            "camera: {position: [0, 0, 4], look_at: [0, 0, 0], fov: 40}\n"
+            "image: {width: 40, height: 30}\n"
+            "ambient: {color: [1, 1, 1], intensity: 1}\n"
+            "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: charted}\n"
+            "  - {type: rectangle, corner: [-2, -1.5, -1], edges: [[4, 0, 0], [0, 3, 0]], "
+            "material: {ka: {type: image, file: library/maps/chart.png}}}\n"),
+      0);
 }
 
 TEST_F(Convert, YamlWithAMeshFileKeepsItsPath) {

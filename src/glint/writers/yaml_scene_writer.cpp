@@ -53,22 +53,30 @@ class Writer {
                                     std::pair{EntityKind::AmbientEntity, "ambient"},
                                     std::pair{EntityKind::FogEntity, "fog"}}) {
       if (const Entity* e = scene_.first(kind)) {
+        rebaseFiles(*e, e->value);
         y += std::string(key) + ":" + flowOrBlock(*e, e->value, 1) + "\n";
       }
     }
-    if (scene_.count(EntityKind::MaterialEntity) > 0) {
-      y += "materials:\n";
-      for (const Entity& e : scene_.entities) {
-        if (e.kind != EntityKind::MaterialEntity) continue;
-        y += "  " + yamlScalar(scene_.text(e, e.name)) + ":" + flowOrBlock(e, e.value, 2) + "\n";
-      }
-    }
+    // Named textures and materials, those of included files too (the output includes nothing).
+    named("textures", EntityKind::TextureEntity);
+    named("materials", EntityKind::MaterialEntity);
     list("objects", EntityKind::ObjectEntity);
     list("lights", EntityKind::LightEntity);
   }
 
  private:
   const ValueTree& tree(const Entity& e) const { return scene_.fileOf(e).values; }
+
+  void named(std::string_view key, EntityKind kind) {
+    if (scene_.count(kind) == 0) return;
+    out_.yaml += std::string(key) + ":\n";
+    for (const Entity& e : scene_.entities) {
+      if (e.kind != kind) continue;
+      rebaseFiles(e, e.value);
+      out_.yaml +=
+          "  " + yamlScalar(scene_.text(e, e.name)) + ":" + flowOrBlock(e, e.value, 2) + "\n";
+    }
+  }
 
   void list(std::string_view key, EntityKind kind) {
     if (scene_.count(kind) == 0) return;
@@ -77,7 +85,7 @@ class Writer {
       if (e.kind != kind) continue;
       out_.yaml += "  - ";
       if (kind == EntityKind::ObjectEntity && asPly(e)) continue;
-      if (kind == EntityKind::ObjectEntity) rebaseFile(e);
+      rebaseFiles(e, e.value);
       const std::string flow = this->flow(e, e.value);
       out_.yaml += flow.size() + 4 <= kFlowWidth ? flow : block(e, e.value, 4, true);
       out_.yaml += "\n";
@@ -150,10 +158,28 @@ class Writer {
     return s;
   }
 
-  // A mesh file written relative to the source scene's folder, from the output's folder.
-  void rebaseFile(const Entity& e) {
-    const ValueId file = scene_.parameter(e, "file");
-    if (file == kNoValue || !tree(e).isScalar(file)) return;
+  // Every `file` in the entity's value, at any depth (a mesh object's file, an image texture's,
+  // inline or named, an image background's), written relative to the folder of the file that
+  // names it: the same file from the output's folder.
+  void rebaseFiles(const Entity& e, ValueId v) {
+    const ValueTree& t = tree(e);
+    if (t.isList(v)) {
+      for (std::size_t i = 0; i < t.size(v); ++i) rebaseFiles(e, t.item(v, i));
+      return;
+    }
+    if (!t.isMap(v)) return;
+    for (std::size_t i = 0; i < t.size(v); ++i) {
+      const ValueId key = t.key(v, i);
+      const ValueId value = t.value(v, i);
+      if (t.isScalar(key) && t.scalar(key) == "file" && t.isScalar(value)) {
+        rebase(e, value);
+      } else {
+        rebaseFiles(e, value);
+      }
+    }
+  }
+
+  void rebase(const Entity& e, ValueId file) {
     const std::filesystem::path written(std::string(tree(e).scalar(file)));
     if (written.is_absolute()) return;
     namespace fs = std::filesystem;
