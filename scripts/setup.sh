@@ -27,6 +27,7 @@ PACKAGES=(
   libyaml-dev libpng-dev libopenexr-dev libtbb-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libassimp-dev assimp-testmodels
+  libcpp-httplib-dev
 )
 # clang with its compiler-rt (libFuzzer, ASan, UBSan runtimes) for the fuzz targets.
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)

@@ -2,7 +2,9 @@
 // `#include "glint/<module>/..."` lines and checks each against the modules it may use:
 //   core ← geometry ← accel ← scene ← render;  readers (scene files as entities) use core only;
 //   mesh uses readers, scene and below; image (files of pictures) uses render's Film and below;
-//   factories turn entities into scene parts; job runs renders; cli only turns arguments into jobs.
+//   factories turn entities into scene parts; job runs renders; preview serves a running job's
+//   picture over HTTP (it consumes job events, so it sits above job); cli only turns arguments into
+//   jobs.
 // Tests (*_test.cpp) may use anything.
 #include <gtest/gtest.h>
 
@@ -32,9 +34,12 @@ const std::map<std::string, std::set<std::string>>& allowedModules() {
       {"job",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
         "job"}},
+      {"preview",
+       {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
+        "job", "preview"}},
       {"cli",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
-        "job", "cli"}},
+        "job", "preview", "cli"}},
   };
   return allowed;
 }
