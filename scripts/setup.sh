@@ -3,7 +3,8 @@
 #
 #   scripts/setup.sh render   install dependencies, build Release, render scenes/showcase.yaml
 #                             to ./showcase.png (in the current folder)
-#   scripts/setup.sh test     install dependencies, build Release, run every test (ctest)
+#   scripts/setup.sh test     install dependencies and the test browser (Chromium, chromedriver,
+#                             Selenium), build Release, run every test (ctest)
 #   scripts/setup.sh deps     only install the dependencies (the default with no command)
 #   scripts/setup.sh build    install dependencies and build Release (build/, binary build/glint)
 #   scripts/setup.sh bench    also install Embree, Tachyon and POV-Ray; build Release with the
@@ -29,6 +30,9 @@ PACKAGES=(
   libassimp-dev assimp-testmodels
   libcpp-httplib-dev
 )
+# The tests beyond the build: the preview page in headless Chromium through WebDriver
+# (tests/browser/).
+TEST_PACKAGES=(chromium chromium-driver python3-selenium)
 # clang with its compiler-rt (libFuzzer, ASan, UBSan runtimes) for the fuzz targets.
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
 # The benchmarks' references: Embree 3 (linked by bench/ only) and the Tachyon and POV-Ray renderers.
@@ -40,7 +44,7 @@ die() {
   exit 1
 }
 
-usage() { sed -n '2,19s/^# \{0,1\}//p' "${BASH_SOURCE[0]}"; }
+usage() { sed -n '2,20s/^# \{0,1\}//p' "${BASH_SOURCE[0]}"; }
 
 command_name=deps
 with_fuzz=0
@@ -65,6 +69,7 @@ wanted_packages() {
   local packages=("${PACKAGES[@]}")
   ((with_fuzz)) && packages+=("${FUZZ_PACKAGES[@]}")
   [[ "$command_name" == bench ]] && packages+=("${BENCH_PACKAGES[@]}")
+  [[ "$command_name" == test ]] && packages+=("${TEST_PACKAGES[@]}")
   printf '%s\n' "${packages[@]}"
 }
 
