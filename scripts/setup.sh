@@ -28,10 +28,10 @@ PACKAGES=(
   libyaml-dev libpng-dev libopenexr-dev libtbb-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libassimp-dev assimp-testmodels
-  libcpp-httplib-dev
+  libcpp-httplib-dev file
 )
 # The tests beyond the build: the preview page in headless Chromium through WebDriver
-# (tests/browser/).
+# (tests/browser/); `file` is for CPack's dpkg-shlibdeps step (tests/deb_package_test.sh).
 TEST_PACKAGES=(chromium chromium-driver python3-selenium)
 # clang with its compiler-rt (libFuzzer, ASan, UBSan runtimes) for the fuzz targets.
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
