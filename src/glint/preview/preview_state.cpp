@@ -1,6 +1,7 @@
 #include "glint/preview/preview_state.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstring>
 #include <utility>
 
@@ -15,6 +16,22 @@ constexpr std::chrono::milliseconds kEncodeInterval{40};
 
 double secondsBetween(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
+}
+
+// FNV-1a over the bit patterns of the pixels of `part` (inside `region`, whose rows of `pixels`
+// are `stride` apart): whether the finished image still holds a block's tile pixels, at the cost
+// of reading them, not of encoding them again.
+std::uint64_t pixelHash(const std::vector<Color>& pixels, const PixelRegion& region, int stride,
+                        const PixelRegion& part) {
+  std::uint64_t hash = 14695981039346656037ull;
+  for (int y = part.y0; y < part.y1; ++y) {
+    const Color* row =
+        pixels.data() + static_cast<std::ptrdiff_t>(y - region.y0) * stride + (part.x0 - region.x0);
+    for (int x = 0; x < part.width(); ++x)
+      for (const double v : {row[x].r, row[x].g, row[x].b})
+        hash = (hash ^ std::bit_cast<std::uint64_t>(v)) * 1099511628211ull;
+  }
+  return hash;
 }
 
 PixelRegion intersection(const PixelRegion& a, const PixelRegion& b) {
@@ -59,6 +76,7 @@ void PreviewState::sceneBuilt(const std::string& name, const PixelRegion& region
     image_.assign(static_cast<std::size_t>(region.width()) * region.height() * 3, 0);
     blockVersion_.assign(blocks, 0);
     blockRank_.assign(blocks, std::nullopt);
+    blockHash_.assign(blocks, std::nullopt);
     ++version_;
   }
   changed_.notify_all();
@@ -127,8 +145,35 @@ void PreviewState::imageFinished(const Film& film) {
   }
   for (const PendingTile& tile : batch)
     paint(tile.region, tile.pixels, tile.region.width(), tile.rank, false);
-  paint(film.region(), film.pixels(), film.width(), {}, true);
+  // Only the blocks whose pixels changed after their tile was painted (the grid), and those never
+  // painted (tiles skipped, or taken from a checkpoint), are encoded again.
+  std::vector<std::uint64_t> versions;
+  std::vector<std::optional<std::uint64_t>> hashes;
+  PixelRegion image;
+  {
+    const std::lock_guard lock(mutex_);
+    versions = blockVersion_;
+    hashes = blockHash_;
+    image = region_;
+  }
+  for (std::size_t index = 0; index < versions.size(); ++index) {
+    const PixelRegion block = blockRegion(index, image);
+    if (versions[index] != 0 && hashes[index] &&
+        *hashes[index] == pixelHash(film.pixels(), film.region(), film.width(), block))
+      continue;
+    paint(film.region(), film.pixels(), film.width(), {}, true, &block);
+  }
   changed_.notify_all();
+}
+
+PixelRegion PreviewState::blockRegion(std::size_t index, const PixelRegion& image) {
+  const auto across =
+      static_cast<std::size_t>((image.width() + kPreviewBlockSize - 1) / kPreviewBlockSize);
+  const int bx = static_cast<int>(index % across);
+  const int by = static_cast<int>(index / across);
+  return {image.x0 + bx * kPreviewBlockSize, image.y0 + by * kPreviewBlockSize,
+          std::min(image.x0 + (bx + 1) * kPreviewBlockSize, image.x1),
+          std::min(image.y0 + (by + 1) * kPreviewBlockSize, image.y1)};
 }
 
 void PreviewState::ended(PreviewPhase phase, const std::string& summary) {
@@ -190,7 +235,7 @@ void PreviewState::encodeLoop() {
 }
 
 void PreviewState::paint(const PixelRegion& region, const std::vector<Color>& pixels, int stride,
-                         std::optional<int> rank, bool onlyIfChanged) {
+                         std::optional<int> rank, bool onlyIfChanged, const PixelRegion* only) {
   PixelRegion image;
   const ChannelEncoder* encode = nullptr;
   {
@@ -198,7 +243,8 @@ void PreviewState::paint(const PixelRegion& region, const std::vector<Color>& pi
     image = region_;
     if (encode_) encode = &*encode_;
   }
-  const PixelRegion inside = intersection(region, image);
+  const PixelRegion inside =
+      only ? intersection(intersection(region, image), *only) : intersection(region, image);
   if (!encode || inside.width() <= 0 || inside.height() <= 0) return;
   // Encoded outside the lock, with the image writers' encodeChannel (as a table): the page shows
   // the bytes of the PNG that will be written.
@@ -213,40 +259,53 @@ void PreviewState::paint(const PixelRegion& region, const std::vector<Color>& pi
       *out++ = (*encode)(row[x].b);
     }
   }
-
-  const std::lock_guard lock(mutex_);
-  const std::uint64_t version = version_ + 1;
-  bool painted = false;
+  // The blocks touched, and for those painted whole the hash of their pixels (imageFinished).
+  struct Touched {
+    std::size_t index;
+    PixelRegion part;
+    std::optional<std::uint64_t> hash;
+  };
+  std::vector<Touched> touched;
   const int bx0 = (inside.x0 - image.x0) / kPreviewBlockSize;
   const int bx1 = (inside.x1 - image.x0 + kPreviewBlockSize - 1) / kPreviewBlockSize;
   const int by0 = (inside.y0 - image.y0) / kPreviewBlockSize;
   const int by1 = (inside.y1 - image.y0 + kPreviewBlockSize - 1) / kPreviewBlockSize;
-  const auto rowBytes = static_cast<std::size_t>(inside.width()) * 3;
-  for (int by = by0; by < by1; ++by) {
+  const auto across =
+      static_cast<std::size_t>((image.width() + kPreviewBlockSize - 1) / kPreviewBlockSize);
+  for (int by = by0; by < by1; ++by)
     for (int bx = bx0; bx < bx1; ++bx) {
-      const PixelRegion block{image.x0 + bx * kPreviewBlockSize, image.y0 + by * kPreviewBlockSize,
-                              std::min(image.x0 + (bx + 1) * kPreviewBlockSize, image.x1),
-                              std::min(image.y0 + (by + 1) * kPreviewBlockSize, image.y1)};
+      const std::size_t index = static_cast<std::size_t>(by) * across + bx;
+      const PixelRegion block = blockRegion(index, image);
       const PixelRegion part = intersection(block, inside);
-      const auto span = static_cast<std::size_t>(part.width()) * 3;
-      const std::size_t index = static_cast<std::size_t>(by) * blocksAcross_ + bx;
-      const auto source = [&](int y) {
-        return rgb.data() + static_cast<std::size_t>(y - inside.y0) * rowBytes +
-               static_cast<std::size_t>(part.x0 - inside.x0) * 3;
-      };
-      const auto target = [&](int y) {
-        return image_.data() +
-               (static_cast<std::size_t>(y - image.y0) * image.width() + (part.x0 - image.x0)) * 3;
-      };
-      bool differs = !onlyIfChanged || blockVersion_[index] == 0;
-      for (int y = part.y0; y < part.y1 && !differs; ++y)
-        differs = std::memcmp(source(y), target(y), span) != 0;
-      if (!differs) continue;
-      for (int y = part.y0; y < part.y1; ++y) std::memcpy(target(y), source(y), span);
-      blockVersion_[index] = version;
-      if (!onlyIfChanged) blockRank_[index] = rank;
-      painted = true;
+      touched.push_back(
+          {index, part,
+           part == block ? std::optional(pixelHash(pixels, region, stride, part)) : std::nullopt});
     }
+
+  const auto rowBytes = static_cast<std::size_t>(inside.width()) * 3;
+  const std::lock_guard lock(mutex_);
+  const std::uint64_t version = version_ + 1;
+  bool painted = false;
+  for (const Touched& block : touched) {
+    const PixelRegion& part = block.part;
+    const auto span = static_cast<std::size_t>(part.width()) * 3;
+    const auto source = [&](int y) {
+      return rgb.data() + static_cast<std::size_t>(y - inside.y0) * rowBytes +
+             static_cast<std::size_t>(part.x0 - inside.x0) * 3;
+    };
+    const auto target = [&](int y) {
+      return image_.data() +
+             (static_cast<std::size_t>(y - image.y0) * image.width() + (part.x0 - image.x0)) * 3;
+    };
+    bool differs = !onlyIfChanged || blockVersion_[block.index] == 0;
+    for (int y = part.y0; y < part.y1 && !differs; ++y)
+      differs = std::memcmp(source(y), target(y), span) != 0;
+    blockHash_[block.index] = block.hash;
+    if (!differs) continue;
+    for (int y = part.y0; y < part.y1; ++y) std::memcpy(target(y), source(y), span);
+    blockVersion_[block.index] = version;
+    if (!onlyIfChanged) blockRank_[block.index] = rank;
+    painted = true;
   }
   if (painted) version_ = version;
 }

@@ -99,8 +99,12 @@ class PreviewState {
   };
 
   void encodeLoop();
+  // Encodes the pixels of `region` (rows `stride` apart in `pixels`; only those inside `only`
+  // when given) into their blocks: all of them, or only blocks whose codes differ.
   void paint(const PixelRegion& region, const std::vector<Color>& pixels, int stride,
-             std::optional<int> rank, bool onlyIfChanged);
+             std::optional<int> rank, bool onlyIfChanged, const PixelRegion* only = nullptr);
+  // Block `index` in full-image pixels, for the image region `image`.
+  static PixelRegion blockRegion(std::size_t index, const PixelRegion& image);
   PreviewStatus statusNow() const;  // with mutex_ held
 
   // Held by whoever paints queued tiles (the encoder, imageFinished) while it does.
@@ -128,6 +132,8 @@ class PreviewState {
   std::vector<std::uint8_t> image_;            // region_ pixels, RGB
   std::vector<std::uint64_t> blockVersion_;    // 0: never painted
   std::vector<std::optional<int>> blockRank_;  // who rendered it
+  // The hash of its pixels when one paint covered it whole (see imageFinished).
+  std::vector<std::optional<std::uint64_t>> blockHash_;
   std::chrono::steady_clock::time_point renderStart_;
   std::chrono::steady_clock::time_point renderEnd_;
   bool closed_ = false;

@@ -153,6 +153,22 @@ TEST(PreviewState, TheFinishedImageRepaintsOnlyWhatDiffersAndTheEndComesAfterIt)
   EXPECT_EQ(assemble(state.waitForChanges(0, 0ms)), encoded(finished, Encoding::Srgb));
 }
 
+TEST(PreviewState, TheFinishedImageFillsBlocksNoTileShowed) {
+  PreviewState state("s");
+  const PixelRegion whole{0, 0, 40, 20};  // blocks cut at the right and bottom edges
+  const Film film = patternFilm(40, 20, whole);
+  state.sceneBuilt("", whole, Encoding::Srgb);
+  state.renderStarting(2, 6);  // as if two tiles came from a checkpoint
+  for (const PixelRegion& tile : tilesOf(whole, 16))
+    if (tile.x0 != 16) state.tileFinished(tile, film, 6, 6);
+  state.imageFinished(film);
+  state.ended(PreviewPhase::Finished, "");
+  const PreviewChanges changes = waitUntil(
+      state, 0, [](const PreviewChanges& c) { return c.status.phase == PreviewPhase::Finished; });
+  EXPECT_EQ(changes.tiles.size(), 6u);
+  EXPECT_EQ(assemble(changes), encoded(film, Encoding::Srgb));
+}
+
 TEST(PreviewState, ReportsEtaWhileRenderingAndFreezesTheTimeAtTheEnd) {
   PreviewState state("s");
   const PixelRegion whole{0, 0, 64, 16};
