@@ -28,7 +28,6 @@ install(FILES ${PROJECT_BINARY_DIR}/glintConfig.cmake ${PROJECT_BINARY_DIR}/glin
 set(CPACK_PACKAGE_NAME glint)
 set(CPACK_PACKAGE_VENDOR "glint")
 set(CPACK_PACKAGE_CONTACT "glint maintainers <glint@localhost>")
-set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "fast, exact Whitted ray tracer for YAML scene files")
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_GENERATOR DEB)
@@ -38,15 +37,14 @@ set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION graphics)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME glint)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
-set(CPACK_COMPONENT_RUNTIME_DESCRIPTION
-    "fast, exact Whitted ray tracer for YAML scene files\n"
-    "Renders scenes of shapes, triangle meshes (OBJ, PLY, STL, glTF), lights and materials to PNG, "
-    "PPM or OpenEXR on every core, with a live preview in the browser.")
+# Each description: the summary line, then the long text (one string: a CMake list would show ';').
+set(CPACK_DEBIAN_RUNTIME_DESCRIPTION "fast, exact Whitted ray tracer for YAML scene files
+Renders scenes of shapes, triangle meshes (OBJ, PLY, STL, glTF), lights and materials to PNG, PPM
+or OpenEXR on every core, with a live preview in the browser.")
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME libglint-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
-set(CPACK_COMPONENT_DEV_DESCRIPTION
-    "glint ray tracer: static library, headers and CMake package\n"
-    "find_package(glint CONFIG) gives the target glint::glint.")
+set(CPACK_DEBIAN_DEV_DESCRIPTION "glint ray tracer: static library, headers and CMake package
+find_package(glint CONFIG) gives the target glint::glint.")
 # What glintConfig.cmake finds (find_dependency, pkg-config), as Debian packages.
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
     "glint (= ${PROJECT_VERSION}), cmake, pkg-config, libtbb-dev, libfmt-dev, libpng-dev, \
