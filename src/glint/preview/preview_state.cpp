@@ -18,20 +18,23 @@ double secondsBetween(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
 }
 
-// FNV-1a over the bit patterns of the pixels of `part` (inside `region`, whose rows of `pixels`
-// are `stride` apart): whether the finished image still holds a block's tile pixels, at the cost
-// of reading them, not of encoding them again.
+// FNV-1a (three interleaved chains) over the bit patterns of the pixels of `part` (inside
+// `region`, whose rows of `pixels` are `stride` apart): whether the finished image still holds a
+// block's tile pixels, at the cost of reading them, not of encoding them again.
 std::uint64_t pixelHash(const std::vector<Color>& pixels, const PixelRegion& region, int stride,
                         const PixelRegion& part) {
-  std::uint64_t hash = 14695981039346656037ull;
+  constexpr std::uint64_t kPrime = 1099511628211ull;
+  std::uint64_t r = 14695981039346656037ull, g = r + 1, b = r + 2;  // three independent chains
   for (int y = part.y0; y < part.y1; ++y) {
     const Color* row =
         pixels.data() + static_cast<std::ptrdiff_t>(y - region.y0) * stride + (part.x0 - region.x0);
-    for (int x = 0; x < part.width(); ++x)
-      for (const double v : {row[x].r, row[x].g, row[x].b})
-        hash = (hash ^ std::bit_cast<std::uint64_t>(v)) * 1099511628211ull;
+    for (int x = 0; x < part.width(); ++x) {
+      r = (r ^ std::bit_cast<std::uint64_t>(row[x].r)) * kPrime;
+      g = (g ^ std::bit_cast<std::uint64_t>(row[x].g)) * kPrime;
+      b = (b ^ std::bit_cast<std::uint64_t>(row[x].b)) * kPrime;
+    }
   }
-  return hash;
+  return ((r ^ (g * kPrime)) * kPrime) ^ b;
 }
 
 PixelRegion intersection(const PixelRegion& a, const PixelRegion& b) {
@@ -106,6 +109,7 @@ void PreviewState::tileFinished(const PixelRegion& region, const Film& film, std
                                 std::size_t tilesTotal, std::optional<int> rank) {
   const auto pixels = static_cast<std::size_t>(region.width()) * region.height();
   bool first = false;  // a caller that did not announce the render: wake the encoder once
+  std::vector<Color> buffer;
   {
     const std::lock_guard lock(queueMutex_);
     first = !rendering_;
@@ -117,9 +121,15 @@ void PreviewState::tileFinished(const PixelRegion& region, const Film& film, std
       return;
     }
     pendingPixels_ += pixels;
+    if (!spare_.empty()) {
+      buffer = std::move(spare_.back());
+      spare_.pop_back();
+    }
   }
-  // Copied outside the lock: other render threads may queue their tiles meanwhile.
-  PendingTile tile{region, rank, std::vector<Color>(pixels)};
+  // Copied outside the lock: other render threads may queue their tiles meanwhile. The buffer is a
+  // spare one (no allocation once the render is under way).
+  buffer.resize(pixels);
+  PendingTile tile{region, rank, std::move(buffer)};
   const PixelRegion& filmRegion = film.region();
   for (int y = region.y0; y < region.y1; ++y) {
     const Color* row = &film.at(region.x0 - filmRegion.x0, y - filmRegion.y0);
@@ -145,6 +155,7 @@ void PreviewState::imageFinished(const Film& film) {
   }
   for (const PendingTile& tile : batch)
     paint(tile.region, tile.pixels, tile.region.width(), tile.rank, false);
+  recycle(batch);
   // Only the blocks whose pixels changed after their tile was painted (the grid), and those never
   // painted (tiles skipped, or taken from a checkpoint), are encoded again.
   std::vector<std::uint64_t> versions;
@@ -184,6 +195,13 @@ void PreviewState::ended(PreviewPhase phase, const std::string& summary) {
   queueChanged_.notify_all();
 }
 
+void PreviewState::recycle(std::vector<PendingTile>& batch) {
+  const std::lock_guard lock(queueMutex_);
+  for (PendingTile& tile : batch)
+    if (spare_.size() < kMaxSpareBuffers) spare_.push_back(std::move(tile.pixels));
+  batch.clear();
+}
+
 void PreviewState::encodeLoop() {
   std::vector<PendingTile> batch;
   for (;;) {
@@ -213,7 +231,7 @@ void PreviewState::encodeLoop() {
     }
     for (const PendingTile& tile : batch)
       paint(tile.region, tile.pixels, tile.region.width(), tile.rank, false);
-    batch.clear();
+    recycle(batch);
     // The end comes after every pixel (the finished image was painted before ended() was called),
     // so that a reader who sees it has the whole picture.
     {
@@ -248,7 +266,8 @@ void PreviewState::paint(const PixelRegion& region, const std::vector<Color>& pi
   if (!encode || inside.width() <= 0 || inside.height() <= 0) return;
   // Encoded outside the lock, with the image writers' encodeChannel (as a table): the page shows
   // the bytes of the PNG that will be written.
-  std::vector<std::uint8_t> rgb(static_cast<std::size_t>(inside.width()) * inside.height() * 3);
+  std::vector<std::uint8_t>& rgb = paintCodes_;
+  rgb.resize(static_cast<std::size_t>(inside.width()) * inside.height() * 3);
   std::uint8_t* out = rgb.data();
   for (int y = inside.y0; y < inside.y1; ++y) {
     const Color* row = pixels.data() + static_cast<std::ptrdiff_t>(y - region.y0) * stride +
@@ -260,12 +279,8 @@ void PreviewState::paint(const PixelRegion& region, const std::vector<Color>& pi
     }
   }
   // The blocks touched, and for those painted whole the hash of their pixels (imageFinished).
-  struct Touched {
-    std::size_t index;
-    PixelRegion part;
-    std::optional<std::uint64_t> hash;
-  };
-  std::vector<Touched> touched;
+  std::vector<Touched>& touched = paintBlocks_;
+  touched.clear();
   const int bx0 = (inside.x0 - image.x0) / kPreviewBlockSize;
   const int bx1 = (inside.x1 - image.x0 + kPreviewBlockSize - 1) / kPreviewBlockSize;
   const int by0 = (inside.y0 - image.y0) / kPreviewBlockSize;

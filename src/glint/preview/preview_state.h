@@ -97,8 +97,17 @@ class PreviewState {
     std::optional<int> rank;
     std::vector<Color> pixels;  // by rows
   };
+  // A block a paint touches, and the hash of its pixels when the paint covers it whole.
+  struct Touched {
+    std::size_t index;
+    PixelRegion part;
+    std::optional<std::uint64_t> hash;
+  };
+  // Pixel buffers kept for reuse: render threads then copy tiles without allocating.
+  static constexpr std::size_t kMaxSpareBuffers = 256;
 
   void encodeLoop();
+  void recycle(std::vector<PendingTile>& batch);  // its buffers to spare_; empties it
   // Encodes the pixels of `region` (rows `stride` apart in `pixels`; only those inside `only`
   // when given) into their blocks: all of them, or only blocks whose codes differ.
   void paint(const PixelRegion& region, const std::vector<Color>& pixels, int stride,
@@ -107,12 +116,16 @@ class PreviewState {
   static PixelRegion blockRegion(std::size_t index, const PixelRegion& image);
   PreviewStatus statusNow() const;  // with mutex_ held
 
-  // Held by whoever paints queued tiles (the encoder, imageFinished) while it does.
+  // Held by whoever paints queued tiles (the encoder, imageFinished) while it does; guards the
+  // scratch buffers of paint.
   std::mutex paintMutex_;
+  std::vector<std::uint8_t> paintCodes_;
+  std::vector<Touched> paintBlocks_;
   // Render threads and the encoder: the tiles waiting to be encoded.
   mutable std::mutex queueMutex_;
   std::condition_variable queueChanged_;
   std::vector<PendingTile> pending_;
+  std::vector<std::vector<Color>> spare_;
   std::size_t pendingPixels_ = 0;
   std::size_t tilesSkipped_ = 0;
   std::size_t tilesDone_ = 0;  // the latest progress a tile reported
