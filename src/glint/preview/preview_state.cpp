@@ -10,24 +10,25 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// How often the encoder looks for finished tiles while rendering. Render threads never wake it:
-// a notification per tile would cost them a system call whenever the encoder sleeps.
-constexpr std::chrono::milliseconds kEncodeInterval{40};
+// How often the publisher looks for finished tiles while rendering. Render threads never wake it:
+// a notification per tile would cost them a system call whenever the publisher sleeps.
+constexpr std::chrono::milliseconds kPublishInterval{40};
 
 double secondsBetween(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
 }
 
 // FNV-1a (three interleaved chains) over the bit patterns of the pixels of `part` (inside
-// `region`, whose rows of `pixels` are `stride` apart): whether the finished image still holds a
-// block's tile pixels, at the cost of reading them, not of encoding them again.
-std::uint64_t pixelHash(const std::vector<Color>& pixels, const PixelRegion& region, int stride,
+// `region`, whose top-left pixel is at `origin` and whose rows are `stride` apart): whether the
+// finished image still holds a block's tile pixels, at the cost of reading them, not of encoding
+// them again.
+std::uint64_t pixelHash(const Color* origin, int stride, const PixelRegion& region,
                         const PixelRegion& part) {
   constexpr std::uint64_t kPrime = 1099511628211ull;
   std::uint64_t r = 14695981039346656037ull, g = r + 1, b = r + 2;  // three independent chains
   for (int y = part.y0; y < part.y1; ++y) {
     const Color* row =
-        pixels.data() + static_cast<std::ptrdiff_t>(y - region.y0) * stride + (part.x0 - region.x0);
+        origin + static_cast<std::ptrdiff_t>(y - region.y0) * stride + (part.x0 - region.x0);
     for (int x = 0; x < part.width(); ++x) {
       r = (r ^ std::bit_cast<std::uint64_t>(row[x].r)) * kPrime;
       g = (g ^ std::bit_cast<std::uint64_t>(row[x].g)) * kPrime;
@@ -49,29 +50,29 @@ PixelRegion intersection(const PixelRegion& a, const PixelRegion& b) {
 
 PreviewState::PreviewState(std::string sceneName) {
   status_.scene = std::move(sceneName);
-  encodingThread_ = std::thread([this]() { encodeLoop(); });
+  publisher_ = std::thread([this]() { publishLoop(); });
 }
 
 PreviewState::~PreviewState() {
   {
     const std::lock_guard lock(queueMutex_);
-    stopEncoder_ = true;
+    stopPublisher_ = true;
   }
   queueChanged_.notify_all();
-  encodingThread_.join();
+  publisher_.join();
   close();
 }
 
 void PreviewState::sceneBuilt(const std::string& name, const PixelRegion& region,
                               Encoding encoding) {
-  const ChannelEncoder encode(encoding);  // about a millisecond: outside the lock
+  // About a millisecond: outside the locks.
+  auto encoder = std::make_shared<const ChannelEncoder>(encoding);
   {
     const std::lock_guard lock(mutex_);
     if (!name.empty()) status_.scene = name;
     status_.width = region.width();
     status_.height = region.height();
     region_ = region;
-    encode_.emplace(encode);
     blocksAcross_ = (region.width() + kPreviewBlockSize - 1) / kPreviewBlockSize;
     const int blocksDown = (region.height() + kPreviewBlockSize - 1) / kPreviewBlockSize;
     const auto blocks =
@@ -81,6 +82,11 @@ void PreviewState::sceneBuilt(const std::string& name, const PixelRegion& region
     blockRank_.assign(blocks, std::nullopt);
     blockHash_.assign(blocks, std::nullopt);
     ++version_;
+  }
+  {
+    const std::lock_guard lock(queueMutex_);
+    encoder_ = std::move(encoder);
+    queueImage_ = region;
   }
   changed_.notify_all();
 }
@@ -108,34 +114,42 @@ void PreviewState::renderStarting(std::size_t tilesResumed, std::size_t tilesTot
 void PreviewState::tileFinished(const PixelRegion& region, const Film& film, std::size_t tilesDone,
                                 std::size_t tilesTotal, std::optional<int> rank) {
   const auto pixels = static_cast<std::size_t>(region.width()) * region.height();
-  bool first = false;  // a caller that did not announce the render: wake the encoder once
-  std::vector<Color> buffer;
+  bool first = false;  // a caller that did not announce the render: wake the publisher once
+  bool queued = false;
+  PendingTile tile;
+  std::shared_ptr<const ChannelEncoder> encode;
+  PixelRegion image;
   {
     const std::lock_guard lock(queueMutex_);
     first = !rendering_;
     rendering_ = true;
     tilesDone_ = std::max(tilesDone_, tilesDone);
     tilesTotal_ = tilesTotal;
-    if (pendingPixels_ + pixels > kMaxPendingPixels) {
+    if (!encoder_ || pendingPixels_ + pixels > kMaxPendingPixels) {
       ++tilesSkipped_;
-      return;
-    }
-    pendingPixels_ += pixels;
-    if (!spare_.empty()) {
-      buffer = std::move(spare_.back());
-      spare_.pop_back();
+    } else {
+      queued = true;
+      encode = encoder_;
+      image = queueImage_;
+      pendingPixels_ += pixels;
+      if (!spare_.empty()) {
+        tile = std::move(spare_.back());
+        spare_.pop_back();
+      }
     }
   }
-  // Copied outside the lock: other render threads may queue their tiles meanwhile. The buffer is a
-  // spare one (no allocation once the render is under way).
-  buffer.resize(pixels);
-  PendingTile tile{region, rank, std::move(buffer)};
-  const PixelRegion& filmRegion = film.region();
-  for (int y = region.y0; y < region.y1; ++y) {
-    const Color* row = &film.at(region.x0 - filmRegion.x0, y - filmRegion.y0);
-    std::copy(row, row + region.width(),
-              tile.pixels.begin() + static_cast<std::ptrdiff_t>(y - region.y0) * region.width());
+  if (!queued) {
+    if (first) queueChanged_.notify_all();
+    return;
   }
+  // Encoded here, outside the lock, while the tile's pixels are still in this core's cache: the
+  // queue then holds 3 bytes a pixel, not 24, and the publishing thread only copies them. The
+  // buffers are recycled ones (no allocation once the render is under way).
+  tile.image = image;
+  tile.inside = intersection(region, image);
+  tile.rank = rank;
+  encodePixels(*encode, film.pixels().data(), film.width(), film.region(), tile.inside, image,
+               tile.codes, tile.blocks);
   {
     const std::lock_guard lock(queueMutex_);
     pending_.push_back(std::move(tile));
@@ -144,8 +158,16 @@ void PreviewState::tileFinished(const PixelRegion& region, const Film& film, std
 }
 
 void PreviewState::imageFinished(const Film& film) {
-  // Painted here, on the job's thread (the render is over), rather than copied for the encoder:
+  // Painted here, on the job's thread (the render is over), rather than copied for the publisher:
   // no second film in memory. The tiles still queued go first, so that none paints over it.
+  std::shared_ptr<const ChannelEncoder> encode;
+  PixelRegion image;
+  {
+    const std::lock_guard lock(queueMutex_);
+    encode = encoder_;
+    image = queueImage_;
+  }
+  if (!encode) return;
   const std::lock_guard painting(paintMutex_);
   std::vector<PendingTile> batch;
   {
@@ -154,25 +176,26 @@ void PreviewState::imageFinished(const Film& film) {
     pendingPixels_ = 0;
   }
   for (const PendingTile& tile : batch)
-    paint(tile.region, tile.pixels, tile.region.width(), tile.rank, false);
+    publish(tile.image, tile.inside, tile.codes, tile.blocks, tile.rank, false);
   recycle(batch);
   // Only the blocks whose pixels changed after their tile was painted (the grid), and those never
   // painted (tiles skipped, or taken from a checkpoint), are encoded again.
   std::vector<std::uint64_t> versions;
   std::vector<std::optional<std::uint64_t>> hashes;
-  PixelRegion image;
   {
     const std::lock_guard lock(mutex_);
+    if (region_ != image) return;
     versions = blockVersion_;
     hashes = blockHash_;
-    image = region_;
   }
   for (std::size_t index = 0; index < versions.size(); ++index) {
     const PixelRegion block = blockRegion(index, image);
     if (versions[index] != 0 && hashes[index] &&
-        *hashes[index] == pixelHash(film.pixels(), film.region(), film.width(), block))
+        *hashes[index] == pixelHash(film.pixels().data(), film.width(), film.region(), block))
       continue;
-    paint(film.region(), film.pixels(), film.width(), {}, true, &block);
+    encodePixels(*encode, film.pixels().data(), film.width(), film.region(), block, image,
+                 paintCodes_, paintBlocks_);
+    publish(image, block, paintCodes_, paintBlocks_, {}, true);
   }
   changed_.notify_all();
 }
@@ -198,11 +221,11 @@ void PreviewState::ended(PreviewPhase phase, const std::string& summary) {
 void PreviewState::recycle(std::vector<PendingTile>& batch) {
   const std::lock_guard lock(queueMutex_);
   for (PendingTile& tile : batch)
-    if (spare_.size() < kMaxSpareBuffers) spare_.push_back(std::move(tile.pixels));
+    if (spare_.size() < kMaxSpareBuffers) spare_.push_back(std::move(tile));
   batch.clear();
 }
 
-void PreviewState::encodeLoop() {
+void PreviewState::publishLoop() {
   std::vector<PendingTile> batch;
   for (;;) {
     std::optional<std::pair<PreviewPhase, std::string>> ending;
@@ -210,12 +233,12 @@ void PreviewState::encodeLoop() {
     std::size_t tilesTotal = 0;
     {
       std::unique_lock lock(queueMutex_);
-      const auto due = [this]() { return stopEncoder_ || ending_.has_value(); };
+      const auto due = [this]() { return stopPublisher_ || ending_.has_value(); };
       if (rendering_)
-        queueChanged_.wait_for(lock, kEncodeInterval, due);
+        queueChanged_.wait_for(lock, kPublishInterval, due);
       else
         queueChanged_.wait(lock, [&]() { return due() || rendering_; });
-      if (stopEncoder_) return;
+      if (stopPublisher_) return;
     }
     // Whoever paints holds paintMutex_ from taking tiles off the queue until they are painted, so
     // that tiles are painted in the order they were queued, and before the finished image.
@@ -230,7 +253,7 @@ void PreviewState::encodeLoop() {
       tilesTotal = tilesTotal_;
     }
     for (const PendingTile& tile : batch)
-      paint(tile.region, tile.pixels, tile.region.width(), tile.rank, false);
+      publish(tile.image, tile.inside, tile.codes, tile.blocks, tile.rank, false);
     recycle(batch);
     // The end comes after every pixel (the finished image was painted before ended() was called),
     // so that a reader who sees it has the whole picture.
@@ -252,35 +275,24 @@ void PreviewState::encodeLoop() {
   }
 }
 
-void PreviewState::paint(const PixelRegion& region, const std::vector<Color>& pixels, int stride,
-                         std::optional<int> rank, bool onlyIfChanged, const PixelRegion* only) {
-  PixelRegion image;
-  const ChannelEncoder* encode = nullptr;
-  {
-    const std::lock_guard lock(mutex_);
-    image = region_;
-    if (encode_) encode = &*encode_;
-  }
-  const PixelRegion inside =
-      only ? intersection(intersection(region, image), *only) : intersection(region, image);
-  if (!encode || inside.width() <= 0 || inside.height() <= 0) return;
-  // Encoded outside the lock, with the image writers' encodeChannel (as a table): the page shows
-  // the bytes of the PNG that will be written.
-  std::vector<std::uint8_t>& rgb = paintCodes_;
-  rgb.resize(static_cast<std::size_t>(inside.width()) * inside.height() * 3);
-  std::uint8_t* out = rgb.data();
+void PreviewState::encodePixels(const ChannelEncoder& encode, const Color* origin, int stride,
+                                const PixelRegion& region, const PixelRegion& inside,
+                                const PixelRegion& image, std::vector<std::uint8_t>& codes,
+                                std::vector<Touched>& blocks) {
+  codes.resize(static_cast<std::size_t>(std::max(inside.width(), 0)) *
+               std::max(inside.height(), 0) * 3);
+  blocks.clear();
+  if (inside.width() <= 0 || inside.height() <= 0) return;
+  std::uint8_t* out = codes.data();
   for (int y = inside.y0; y < inside.y1; ++y) {
-    const Color* row = pixels.data() + static_cast<std::ptrdiff_t>(y - region.y0) * stride +
-                       (inside.x0 - region.x0);
+    const Color* row =
+        origin + static_cast<std::ptrdiff_t>(y - region.y0) * stride + (inside.x0 - region.x0);
     for (int x = 0; x < inside.width(); ++x) {
-      *out++ = (*encode)(row[x].r);
-      *out++ = (*encode)(row[x].g);
-      *out++ = (*encode)(row[x].b);
+      *out++ = encode(row[x].r);
+      *out++ = encode(row[x].g);
+      *out++ = encode(row[x].b);
     }
   }
-  // The blocks touched, and for those painted whole the hash of their pixels (imageFinished).
-  std::vector<Touched>& touched = paintBlocks_;
-  touched.clear();
   const int bx0 = (inside.x0 - image.x0) / kPreviewBlockSize;
   const int bx1 = (inside.x1 - image.x0 + kPreviewBlockSize - 1) / kPreviewBlockSize;
   const int by0 = (inside.y0 - image.y0) / kPreviewBlockSize;
@@ -292,20 +304,26 @@ void PreviewState::paint(const PixelRegion& region, const std::vector<Color>& pi
       const std::size_t index = static_cast<std::size_t>(by) * across + bx;
       const PixelRegion block = blockRegion(index, image);
       const PixelRegion part = intersection(block, inside);
-      touched.push_back(
+      blocks.push_back(
           {index, part,
-           part == block ? std::optional(pixelHash(pixels, region, stride, part)) : std::nullopt});
+           part == block ? std::optional(pixelHash(origin, stride, region, part)) : std::nullopt});
     }
+}
 
+void PreviewState::publish(const PixelRegion& image, const PixelRegion& inside,
+                           const std::vector<std::uint8_t>& codes,
+                           const std::vector<Touched>& blocks, std::optional<int> rank,
+                           bool onlyIfChanged) {
   const auto rowBytes = static_cast<std::size_t>(inside.width()) * 3;
   const std::lock_guard lock(mutex_);
+  if (image != region_) return;  // encoded for a scene announced before this one
   const std::uint64_t version = version_ + 1;
   bool painted = false;
-  for (const Touched& block : touched) {
+  for (const Touched& block : blocks) {
     const PixelRegion& part = block.part;
     const auto span = static_cast<std::size_t>(part.width()) * 3;
     const auto source = [&](int y) {
-      return rgb.data() + static_cast<std::size_t>(y - inside.y0) * rowBytes +
+      return codes.data() + static_cast<std::size_t>(y - inside.y0) * rowBytes +
              static_cast<std::size_t>(part.x0 - inside.x0) * 3;
     };
     const auto target = [&](int y) {

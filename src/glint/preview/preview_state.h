@@ -1,12 +1,13 @@
 // PreviewState: what the preview page shows of one render — the image, encoded to 8 bits exactly as
 // the output file will be, the progress and the outcome — filled by the render's callbacks without
-// ever making them wait, and read by the preview server's connections.
+// ever making them wait for a reader, and read by the preview server's connections.
 #pragma once
 
 #include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -55,8 +56,8 @@ struct PreviewChanges {
 
 class PreviewState {
  public:
-  // Render tiles' pixels waiting to be encoded, at most: beyond this a tile is not shown until the
-  // render ends (the finished image repaints everything), so the render never waits for the page.
+  // Render tiles' pixels waiting to be published, at most: beyond this a tile is not shown until
+  // the render ends (the finished image repaints what is missing), so the render never waits.
   static constexpr std::size_t kMaxPendingPixels = std::size_t{1} << 22;
 
   explicit PreviewState(std::string sceneName);
@@ -69,8 +70,9 @@ class PreviewState {
   // its pixels are encoded to 8 bits.
   void sceneBuilt(const std::string& name, const PixelRegion& region, Encoding encoding);
   void renderStarting(std::size_t tilesResumed, std::size_t tilesTotal);
-  // From a render thread: copies the tile's pixels (final in `film`) and returns; they are encoded
-  // on this state's own thread. `region` is in full-image pixels, as the film's.
+  // From a render thread: encodes the tile's pixels (final in `film`; a few nanoseconds a pixel,
+  // the image writers' encodeChannel as a table) into a queue and returns; this state's own thread
+  // publishes them. `region` is in full-image pixels, as the film's.
   void tileFinished(const PixelRegion& region, const Film& film, std::size_t tilesDone,
                     std::size_t tilesTotal, std::optional<int> rank = std::nullopt);
   // The finished image as it will be written (grid included): repaints every block that differs
@@ -92,66 +94,79 @@ class PreviewState {
   std::size_t tilesSkipped() const;
 
  private:
-  struct PendingTile {
-    PixelRegion region;  // image pixels
-    std::optional<int> rank;
-    std::vector<Color> pixels;  // by rows
-  };
-  // A block a paint touches, and the hash of its pixels when the paint covers it whole.
+  // A block that encoded pixels touch, and the hash of its pixels when they cover it whole.
   struct Touched {
     std::size_t index;
     PixelRegion part;
     std::optional<std::uint64_t> hash;
   };
-  // Pixel buffers kept for reuse: render threads then copy tiles without allocating.
+  // A finished tile, encoded, waiting to be published.
+  struct PendingTile {
+    PixelRegion image;   // the rendered region when it was encoded: what `blocks` index
+    PixelRegion inside;  // full-image pixels, within `image`
+    std::optional<int> rank;
+    std::vector<std::uint8_t> codes;  // 3 a pixel, by rows
+    std::vector<Touched> blocks;
+  };
+  // Tiles kept for reuse: render threads then queue tiles without allocating.
   static constexpr std::size_t kMaxSpareBuffers = 256;
 
-  void encodeLoop();
+  void publishLoop();
   void recycle(std::vector<PendingTile>& batch);  // its buffers to spare_; empties it
-  // Encodes the pixels of `region` (rows `stride` apart in `pixels`; only those inside `only`
-  // when given) into their blocks: all of them, or only blocks whose codes differ.
-  void paint(const PixelRegion& region, const std::vector<Color>& pixels, int stride,
-             std::optional<int> rank, bool onlyIfChanged, const PixelRegion* only = nullptr);
+  // The codes of the pixels `inside` (rows `stride` apart from `origin`, the top-left pixel of
+  // `region`) and the blocks of `image` they touch.
+  static void encodePixels(const ChannelEncoder& encode, const Color* origin, int stride,
+                           const PixelRegion& region, const PixelRegion& inside,
+                           const PixelRegion& image, std::vector<std::uint8_t>& codes,
+                           std::vector<Touched>& blocks);
+  // Copies encoded pixels into the image and gives their blocks a new version: all of them, or
+  // only those whose codes differ. Nothing when `image` is no longer the rendered region.
+  void publish(const PixelRegion& image, const PixelRegion& inside,
+               const std::vector<std::uint8_t>& codes, const std::vector<Touched>& blocks,
+               std::optional<int> rank, bool onlyIfChanged);
   // Block `index` in full-image pixels, for the image region `image`.
   static PixelRegion blockRegion(std::size_t index, const PixelRegion& image);
   PreviewStatus statusNow() const;  // with mutex_ held
 
-  // Held by whoever paints queued tiles (the encoder, imageFinished) while it does; guards the
-  // scratch buffers of paint.
+  // Held by whoever publishes queued tiles (the publisher, imageFinished) while it does; guards
+  // the scratch buffers of imageFinished.
   std::mutex paintMutex_;
   std::vector<std::uint8_t> paintCodes_;
   std::vector<Touched> paintBlocks_;
-  // Render threads and the encoder: the tiles waiting to be encoded.
+  // Render threads and the publishing thread: the tiles waiting to be published.
   mutable std::mutex queueMutex_;
   std::condition_variable queueChanged_;
   std::vector<PendingTile> pending_;
-  std::vector<std::vector<Color>> spare_;
+  std::vector<PendingTile> spare_;
+  // Set with the scene. Shared, so that a render thread encoding outside the lock keeps the one
+  // it took even if the scene is announced again.
+  std::shared_ptr<const ChannelEncoder> encoder_;
+  PixelRegion queueImage_;  // region_, likewise
   std::size_t pendingPixels_ = 0;
   std::size_t tilesSkipped_ = 0;
   std::size_t tilesDone_ = 0;  // the latest progress a tile reported
   std::size_t tilesTotal_ = 0;
   std::optional<std::pair<PreviewPhase, std::string>> ending_;
-  bool rendering_ = false;  // the encoder polls while tiles may come, and sleeps otherwise
-  bool stopEncoder_ = false;
+  bool rendering_ = false;  // the publisher polls while tiles may come, and sleeps otherwise
+  bool stopPublisher_ = false;
 
-  // The encoder, the job's thread and the readers: the 8-bit image and the status.
+  // The publisher, the job's thread and the readers: the 8-bit image and the status.
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::uint64_t version_ = 0;
   PreviewStatus status_;
-  PixelRegion region_;                    // full-image pixels rendered
-  std::optional<ChannelEncoder> encode_;  // set once, with the scene; immutable after
+  PixelRegion region_;  // full-image pixels rendered
   int blocksAcross_ = 0;
   std::vector<std::uint8_t> image_;            // region_ pixels, RGB
   std::vector<std::uint64_t> blockVersion_;    // 0: never painted
   std::vector<std::optional<int>> blockRank_;  // who rendered it
-  // The hash of its pixels when one paint covered it whole (see imageFinished).
+  // The hash of its pixels when one tile covered it whole (see imageFinished).
   std::vector<std::optional<std::uint64_t>> blockHash_;
   std::chrono::steady_clock::time_point renderStart_;
   std::chrono::steady_clock::time_point renderEnd_;
   bool closed_ = false;
 
-  std::thread encodingThread_;
+  std::thread publisher_;
 };
 
 }  // namespace glint

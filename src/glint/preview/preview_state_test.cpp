@@ -109,6 +109,25 @@ TEST(PreviewState, ACropIsItsOwnImage) {
   EXPECT_EQ(assemble(changes), encoded(film, Encoding::Srgb));
 }
 
+// Tiles queued for the first announcement (a larger image) must not land in the second one's
+// blocks; the second image is whole and encoded its own way.
+TEST(PreviewState, ASceneAnnouncedAgainStartsAFreshImage) {
+  PreviewState state("s");
+  const PixelRegion large{0, 0, 96, 64};
+  const PixelRegion small{0, 0, 32, 16};
+  const Film largeFilm = patternFilm(96, 64, large);
+  const Film smallFilm = patternFilm(32, 16, small, 0.25);
+  state.sceneBuilt("", large, Encoding::Srgb);
+  renderAll(state, largeFilm);
+  state.sceneBuilt("", small, Encoding::Linear);
+  renderAll(state, smallFilm);
+  state.imageFinished(smallFilm);
+  const PreviewChanges changes = waitUntil(state, 0, [](const PreviewChanges& c) {
+    return c.status.width == 32 && c.tiles.size() == 2;
+  });
+  EXPECT_EQ(assemble(changes), encoded(smallFilm, Encoding::Linear));
+}
+
 TEST(PreviewState, ASlowReaderGetsEachBlocksLatestPixelsOnce) {
   PreviewState state("s");
   const PixelRegion whole{0, 0, 32, 16};
