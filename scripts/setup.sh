@@ -36,7 +36,8 @@ TEST_PACKAGES=(chromium chromium-driver python3-selenium)
 # clang with its compiler-rt (libFuzzer, ASan, UBSan runtimes) for the fuzz targets.
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
 # The benchmarks' references: Embree 3 (linked by bench/ only) and the Tachyon and POV-Ray renderers.
-BENCH_PACKAGES=(libembree-dev libbenchmark-dev tachyon povray)
+# matplotlib draws the benchmark plots in docs/images/ (scripts/plot_benchmarks.py).
+BENCH_PACKAGES=(libembree-dev libbenchmark-dev tachyon povray python3-matplotlib)
 
 log() { printf 'setup: %s\n' "$*" >&2; }
 die() {
