@@ -29,6 +29,7 @@
 #include "glint/mesh/import_child.h"
 #include "glint/mesh/mesh_cache.h"
 #include "glint/scene/scene_limits.h"
+#include "sanitizer.h"
 
 namespace glint {
 namespace {
@@ -39,19 +40,6 @@ using ::testing::HasSubstr;
 
 const fs::path kGlint = fs::path(GLINT_BINARY_DIR) / "glint";
 
-// Under the address sanitizer glint's memory is mostly the sanitizer's (shadow memory, the
-// quarantine of freed blocks): peak-memory figures say nothing about glint then.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
 const fs::path kTorusKnot = fs::path(GLINT_SOURCE_DIR) / "scenes" / "meshes" / "torus_knot.obj";
 
 // The smallest scene around mesh objects: a camera, an image, a light.

@@ -103,15 +103,19 @@ class Builder {
     const ValueReader reader = readerOf(e);
     const std::string name(reader.tree().scalar(e.name));
     if (const auto it = materialIndex_.find(name); it != materialIndex_.end()) {
-      const TextPosition first = materialWhere_[it->second];
-      reader.error(e.name, fmt::format("duplicate material '{}': defined twice (first at line {}, "
-                                       "column {})",
-                                       escapeForMessage(name), first.line, first.column));
+      // Both places; the file too when the first is in another one (an included file).
+      const auto& [firstFile, first] = materialWhere_[it->second];
+      const std::string where =
+          firstFile == e.file ? fmt::format("line {}, column {}", first.line, first.column)
+                              : fmt::format("{}:{}:{}", escapeForMessage(d_.files[firstFile]->name),
+                                            first.line, first.column);
+      reader.error(e.name, fmt::format("duplicate material '{}': defined twice (first at {})",
+                                       escapeForMessage(name), where));
       return;
     }
     const auto index = static_cast<std::uint32_t>(parts_.materials.size());
     materialIndex_.emplace(name, index);
-    materialWhere_[index] = reader.tree().position(e.name);
+    materialWhere_[index] = {e.file, reader.tree().position(e.name)};
     const std::string path = "materials." + name;
     auto params = entityParameters(reader, e.value, e.name,
                                    "a mapping of material keys (kd, ks, shininess, kr, kt, ka, "
@@ -467,7 +471,7 @@ class Builder {
   BuildContext ctx_;
   BuildResult& result_;
   std::map<std::string, std::uint32_t, std::less<>> materialIndex_;
-  std::map<std::uint32_t, TextPosition> materialWhere_;
+  std::map<std::uint32_t, std::pair<std::uint32_t, TextPosition>> materialWhere_;  // file, place
   MeshCache meshCache_;  // each mesh file read once per scene
   std::map<const MeshFile*, std::vector<std::uint32_t>> fileMaterials_;
   std::uint64_t meshTriangles_ = 0;            // in parts_.meshes

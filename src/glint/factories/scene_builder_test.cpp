@@ -576,6 +576,38 @@ TEST(SceneBuilder, Warnings) {
           .warnings.empty());
 }
 
+TEST(SceneBuilder, YamlMergeKeysShareMaterialsAndObjects) {
+  const SceneParts p = partsOf(std::string(kMinimal) +
+                               "materials:\n"
+                               "  paint: &paint {kd: [0.8, 0.2, 0.2], ks: 0.5, shininess: 40}\n"
+                               "  shiny: {<<: *paint, kr: 0.3, ks: 0.9}\n"
+                               "objects:\n"
+                               "  - &ball {type: sphere, center: [0, 0, -5], radius: 1, "
+                               "material: shiny}\n"
+                               "  - {<<: *ball, center: [2, 0, -5]}\n"
+                               "lights: [{type: point, position: [4, 4, 4]}]\n");
+  ASSERT_EQ(p.materials.size(), 3u);
+  EXPECT_EQ(p.materials[2].kd, Color(0.8, 0.2, 0.2));
+  EXPECT_EQ(p.materials[2].ks, Color(0.9));
+  EXPECT_EQ(p.materials[2].kr, Color(0.3));
+  EXPECT_EQ(p.materials[2].shininess, 40);
+  ASSERT_EQ(p.primitives.size(), 2u);
+  EXPECT_EQ(std::get<Sphere>(p.primitives[1].shape()).center, (Point3{2, 0, -5}));
+  EXPECT_EQ(p.primitives[1].materialIndex(), 2u);
+  // A misspelt key merged in is reported where it was written, for each material that has it.
+  const std::vector<Diagnostic> errors = errorsOf(std::string(kMinimal) +
+                                                  "materials:\n"
+                                                  "  base: &base {kd: 0.5, shinyness: 4}\n"
+                                                  "  other: {<<: *base}\n");
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].format(),
+            "test.yaml:4:25: unknown key 'shinyness' in material 'base'; expected one of: kd, ks, "
+            "shininess, kr, kt, ka, ior, reflection_blur, refraction_blur (did you mean "
+            "'shininess'?)");
+  EXPECT_THAT(errors[1].format(), HasSubstr("test.yaml:4:25: unknown key 'shinyness' in material "
+                                            "'other'"));
+}
+
 TEST(SceneBuilder, ObjectsThatReflectNoLightUnderLightsAreWarnings) {
   // Under a light, an object without a material (or with one of all-zero kd, ks, kr, kt) shows
   // only the ambient light: one warning at the object, naming why.

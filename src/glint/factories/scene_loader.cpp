@@ -1,6 +1,8 @@
 #include "glint/factories/scene_loader.h"
 
 #include <algorithm>
+#include <functional>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -11,11 +13,21 @@
 namespace glint {
 namespace {
 
-// File order: by file (the scene first, then what it includes), then line and column.
-bool before(const Diagnostic& a, const Diagnostic& b) {
-  if (a.where.line != b.where.line) return a.where.line < b.where.line;
-  return a.where.column < b.where.column;
-}
+// File order: by file (the scene first, then the files it includes, in the order they were
+// read), then line and column.
+struct InFileOrder {
+  std::map<std::string, std::size_t> fileIndex;
+  std::size_t indexOf(const std::string& file) const {
+    const auto it = fileIndex.find(file);
+    return it == fileIndex.end() ? 0 : it->second;
+  }
+  bool operator()(const Diagnostic& a, const Diagnostic& b) const {
+    const std::size_t fa = indexOf(a.where.file), fb = indexOf(b.where.file);
+    if (fa != fb) return fa < fb;
+    if (a.where.line != b.where.line) return a.where.line < b.where.line;
+    return a.where.column < b.where.column;
+  }
+};
 
 LoadedScene build(ParseResult parsed, const LoadOptions& options) {
   BuildOptions buildOptions;
@@ -32,11 +44,15 @@ LoadedScene build(ParseResult parsed, const LoadOptions& options) {
     }
   }
   // The reader and the builder each report in their own walk of the file.
-  std::stable_sort(errors.begin(), errors.end(), before);
-  std::stable_sort(warnings.begin(), warnings.end(), before);
+  InFileOrder before;
+  for (std::size_t i = 0; i < parsed.description.files.size(); ++i) {
+    before.fileIndex.emplace(parsed.description.files[i]->name, i);
+  }
+  std::stable_sort(errors.begin(), errors.end(), std::cref(before));
+  std::stable_sort(warnings.begin(), warnings.end(), std::cref(before));
   if (!errors.empty()) throw SceneError(std::move(errors));
   const SourceFile& scene = *parsed.description.files.at(0);
-  return LoadedScene{std::move(built.parts), std::move(warnings), scene.bytes, scene.fnv1a};
+  return LoadedScene{std::move(built.parts), std::move(warnings), scene.bytes};
 }
 
 }  // namespace

@@ -22,7 +22,6 @@ struct LoadedScene {
   SceneParts parts;
   std::vector<Diagnostic> warnings;
   std::uint64_t sceneBytes = 0;        // size of the scene file (or text)
-  std::uint64_t sceneFingerprint = 0;  // 64-bit FNV-1a hash of its bytes
 };
 
 struct LoadOptions {

@@ -34,7 +34,6 @@ struct SourceFile {
   std::string name;                     // as the user gave it, for messages
   std::filesystem::path baseDirectory;  // relative paths inside the file resolve from here
   ValueTree values;
-  std::uint64_t fnv1a = 0;  // 64-bit FNV-1a hash of the file's bytes
   std::uint64_t bytes = 0;
 
   SourceText source() const { return {&values, &name}; }

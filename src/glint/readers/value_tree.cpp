@@ -37,7 +37,7 @@ TextPosition ValueTree::position(ValueId id) const {
 std::size_t ValueTree::memoryBytes() const {
   return values_.capacity() * sizeof(Value) + links_.capacity() * sizeof(ValueId) +
          text_.capacity() + lines_.capacity() * sizeof(lines_[0]) +
-         interned_.size() * (sizeof(std::string) + 48);
+         textCache_.capacity() * sizeof(CachedText);
 }
 
 void ValueTree::reserveForText(std::uint64_t bytes) {
@@ -68,12 +68,20 @@ std::uint32_t ValueTree::storeText(std::string_view text) {
   const bool identifier =
       !text.empty() && text.size() <= kInternedLength &&
       ((text[0] >= 'a' && text[0] <= 'z') || (text[0] >= 'A' && text[0] <= 'Z') || text[0] == '_');
+  CachedText* slot = nullptr;
   if (identifier) {
-    if (const auto it = interned_.find(text); it != interned_.end()) return it->second;
+    // FNV-1a of the text picks the slot; a collision only stores the text again.
+    std::uint32_t hash = 2166136261u;
+    for (const char c : text) hash = (hash ^ static_cast<unsigned char>(c)) * 16777619u;
+    slot = &textCache_[hash % kTextCacheSlots];
+    if (slot->length == text.size() &&
+        std::string_view(text_).substr(slot->offset, slot->length) == text) {
+      return slot->offset;
+    }
   }
   const auto offset = static_cast<std::uint32_t>(text_.size());
   text_.append(text);
-  if (identifier && interned_.size() < kMaxInterned) interned_.emplace(std::string(text), offset);
+  if (slot != nullptr) *slot = {offset, static_cast<std::uint32_t>(text.size())};
   return offset;
 }
 
@@ -112,6 +120,18 @@ void ValueTree::close() {
   links_.insert(links_.end(), pending_.begin() + static_cast<std::ptrdiff_t>(frame.firstPending),
                 pending_.end());
   pending_.resize(frame.firstPending);
+}
+
+std::vector<ValueId> ValueTree::openChildren() const {
+  assert(!frames_.empty());
+  return {pending_.begin() + static_cast<std::ptrdiff_t>(frames_.back().firstPending),
+          pending_.end()};
+}
+
+void ValueTree::replaceOpenChildren(const std::vector<ValueId>& children) {
+  assert(!frames_.empty());
+  pending_.resize(frames_.back().firstPending);
+  pending_.insert(pending_.end(), children.begin(), children.end());
 }
 
 void ValueTree::attach(ValueId id) {

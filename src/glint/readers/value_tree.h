@@ -71,11 +71,14 @@ class ValueTree {
   // The first value added outside any collection (the document's root), or kNoValue.
   ValueId root() const { return root_; }
   std::size_t openCollections() const { return frames_.size(); }
+  // The children added so far to the innermost open collection (a mapping's: key, value, ...), and
+  // their replacement before it is closed (a reader resolving YAML merge keys).
+  std::vector<ValueId> openChildren() const;
+  void replaceOpenChildren(const std::vector<ValueId>& children);
 
   // Short identifier-like scalars (keys, type names, material names: a letter or '_' first) are
-  // stored once; numbers and longer text each time. The table stops growing at kMaxInterned.
+  // stored once per text in a small cache; numbers and longer text each time.
   static constexpr std::size_t kInternedLength = 24;
-  static constexpr std::size_t kMaxInterned = 4096;
 
  private:
   struct Value {
@@ -90,12 +93,14 @@ class ValueTree {
   std::vector<Value> values_;
   std::vector<ValueId> links_;
   std::string text_;
-  // Identifier-like short scalars already stored, and their text offset (at most kMaxInterned).
-  struct TextHash {
-    using is_transparent = void;
-    std::size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
+  // Identifier-like short scalars already stored: a direct-mapped cache of (offset, length) by a
+  // hash of the text, so repeated keys and type names are stored once at the cost of one compare.
+  struct CachedText {
+    std::uint32_t offset = 0;
+    std::uint32_t length = 0;  // 0: empty slot
   };
-  std::unordered_map<std::string, std::uint32_t, TextHash, std::equal_to<>> interned_;
+  static constexpr std::size_t kTextCacheSlots = 512;
+  std::vector<CachedText> textCache_ = std::vector<CachedText>(kTextCacheSlots);
   // (offset of the first character of a line, line number) for every line holding a value,
   // ascending.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> lines_;

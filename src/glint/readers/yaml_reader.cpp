@@ -4,12 +4,18 @@
 #include <unistd.h>
 #include <yaml.h>
 
+#include <oneapi/tbb/global_control.h>
+
 #include <algorithm>
 #include <cerrno>
+#include <condition_variable>
 #include <cstring>
+#include <deque>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <system_error>
+#include <thread>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -27,9 +33,6 @@ constexpr std::size_t kEventsPerPoll = 4096;
 // Bytes libyaml asks for at a time from a file.
 constexpr std::size_t kReadBlock = std::size_t{1} << 16;
 
-constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
-constexpr std::uint64_t kFnvPrime = 1099511628211ull;
-
 std::uint64_t saturatingAdd(std::uint64_t a, std::uint64_t b) {
   return a > UINT64_MAX - b ? UINT64_MAX : a + b;
 }
@@ -39,7 +42,7 @@ TextPosition positionOf(const yaml_mark_t& mark) {
           static_cast<std::uint32_t>(mark.line + 1), static_cast<std::uint32_t>(mark.column + 1)};
 }
 
-// Where the text is read from: in memory, or a file descriptor in blocks. Keeps the running hash
+// Where the text is read from: in memory, or a file descriptor in blocks. Counts the bytes read
 // and can give back one line of the text for error messages.
 class Source {
  public:
@@ -49,16 +52,12 @@ class Source {
   bool inMemory() const { return fd_ < 0; }
   std::string_view text() const { return text_; }
   std::uint64_t bytesRead() const { return bytesRead_; }
-  std::uint64_t hash() const { return hash_; }
   bool tooLarge() const { return tooLarge_; }
   int readErrno() const { return readErrno_; }
   const std::atomic<bool>* cancel = nullptr;
   bool cancelled = false;
 
-  void hashBytes(const unsigned char* data, std::size_t size) {
-    for (std::size_t i = 0; i < size; ++i) hash_ = (hash_ ^ data[i]) * kFnvPrime;
-    bytesRead_ += size;
-  }
+  void countBytes(std::size_t size) { bytesRead_ += size; }
 
   // libyaml's read handler: fills buffer with up to `size` bytes; 0 = error.
   static int readHandler(void* data, unsigned char* buffer, std::size_t size,
@@ -82,7 +81,7 @@ class Source {
         self->readErrno_ = errno;
         return 0;
       }
-      self->hashBytes(buffer, static_cast<std::size_t>(n));
+      self->countBytes(static_cast<std::size_t>(n));
       if (self->bytesRead_ > self->maxBytes_) {
         self->tooLarge_ = true;
         return 0;
@@ -163,7 +162,6 @@ class Source {
   int fd_ = -1;
   std::uint64_t maxBytes_ = 0;
   std::uint64_t bytesRead_ = 0;
-  std::uint64_t hash_ = kFnvOffset;
   bool tooLarge_ = false;
   int readErrno_ = 0;
 };
@@ -223,6 +221,112 @@ std::string characterAt(std::string_view line, std::uint32_t column) {
   return {};
 }
 
+// Texts from this size up are parsed on a second thread while the tree is built (when the job
+// allows two threads): below it the thread costs more than it saves.
+constexpr std::uint64_t kPipelinedBytes = std::uint64_t{1} << 20;
+// Events handed over at a time, and batches that may wait: bounds the memory of the hand-over.
+constexpr std::size_t kEventsPerBatch = 1024;
+constexpr std::size_t kBatchesInFlight = 8;
+
+// Threads this process may use now (the job's --threads, through oneTBB's global control).
+std::size_t allowedThreads() {
+  return tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+}
+
+struct EventGuard {
+  yaml_event_t* event;
+  ~EventGuard() { yaml_event_delete(event); }
+};
+
+// What a failed yaml_parser_parse left in the parser, kept for the message (libyaml's problem
+// texts are static strings).
+struct ParseFailure {
+  yaml_error_type_t error = YAML_NO_ERROR;
+  const char* problem = nullptr;
+  std::size_t problem_offset = 0;
+  int problem_value = 0;
+  yaml_mark_t problem_mark{};
+  static ParseFailure of(const yaml_parser_t& parser) {
+    return {parser.error, parser.problem, parser.problem_offset, parser.problem_value,
+            parser.problem_mark};
+  }
+};
+
+// Batches of events from the parsing thread to the building one (a bounded queue).
+class EventPipe {
+ public:
+  // The parsing thread: parses until the end of the stream, a failure, or stop().
+  void produce(yaml_parser_t& parser) {
+    std::vector<yaml_event_t> batch;
+    batch.reserve(kEventsPerBatch);
+    bool end = false;
+    while (!end) {
+      yaml_event_t event;
+      if (yaml_parser_parse(&parser, &event) == 0) {
+        failure_ = ParseFailure::of(parser);
+        end = true;
+      } else {
+        end = event.type == YAML_STREAM_END_EVENT;
+        batch.push_back(event);
+      }
+      if (end || batch.size() == kEventsPerBatch) {
+        if (!push(std::move(batch))) return;
+        batch = {};
+        batch.reserve(kEventsPerBatch);
+      }
+    }
+    std::lock_guard lock(mutex_);
+    finished_ = true;
+    ready_.notify_all();
+  }
+
+  // The building thread: the next batch, or false when there is none and will be none.
+  bool next(std::vector<yaml_event_t>& batch) {
+    std::unique_lock lock(mutex_);
+    ready_.wait(lock, [&] { return !queue_.empty() || finished_ || stopped_; });
+    if (queue_.empty()) return false;
+    batch = std::move(queue_.front());
+    queue_.pop_front();
+    space_.notify_all();
+    return true;
+  }
+
+  void stop() {
+    std::lock_guard lock(mutex_);
+    stopped_ = true;
+    space_.notify_all();
+    ready_.notify_all();
+  }
+  // After the parsing thread has ended: frees the events nobody took.
+  void freeRemaining() {
+    for (std::vector<yaml_event_t>& batch : queue_) {
+      for (yaml_event_t& event : batch) yaml_event_delete(&event);
+    }
+    queue_.clear();
+  }
+  const ParseFailure& failure() const { return failure_; }
+
+ private:
+  bool push(std::vector<yaml_event_t> batch) {
+    std::unique_lock lock(mutex_);
+    space_.wait(lock, [&] { return queue_.size() < kBatchesInFlight || stopped_; });
+    if (stopped_) {
+      for (yaml_event_t& event : batch) yaml_event_delete(&event);
+      return false;
+    }
+    queue_.push_back(std::move(batch));
+    ready_.notify_all();
+    return true;
+  }
+
+  std::mutex mutex_;
+  std::condition_variable ready_, space_;
+  std::deque<std::vector<yaml_event_t>> queue_;
+  bool finished_ = false;
+  bool stopped_ = false;
+  ParseFailure failure_;
+};
+
 class Reader {
  public:
   Reader(Source& source, const Limits& limits, const std::atomic<bool>* cancel)
@@ -242,31 +346,75 @@ class Reader {
       const std::string_view text = source_.text();
       yaml_parser_set_input_string(&parser, reinterpret_cast<const unsigned char*>(text.data()),
                                    text.size());
-      source_.hashBytes(reinterpret_cast<const unsigned char*>(text.data()), text.size());
+      source_.countBytes(text.size());
     } else {
       yaml_parser_set_input(&parser, &Source::readHandler, &source_);
     }
-    yaml_parser_set_encoding(&parser, YAML_UTF8_ENCODING);
+    if (expectedBytes >= kPipelinedBytes && allowedThreads() >= 2) {
+      runPipelined(parser);
+    } else {
+      runSerial(parser);
+    }
+    doc_.root = doc_.values.root();
+    doc_.bytesRead = source_.bytesRead();
+    return std::move(doc_);
+  }
 
+ private:
+  // One thread: parse an event, add it to the tree, free it.
+  void runSerial(yaml_parser_t& parser) {
     std::size_t events = 0;
     bool done = false;
     while (!done) {
       if (++events % kEventsPerPoll == 0) throwIfCancelled(cancel_);
       yaml_event_t event;
-      if (yaml_parser_parse(&parser, &event) == 0) fail(parser);
-      struct EventGuard {
-        yaml_event_t* event;
-        ~EventGuard() { yaml_event_delete(event); }
-      } eventGuard{&event};
+      if (yaml_parser_parse(&parser, &event) == 0) fail(ParseFailure::of(parser));
+      EventGuard eventGuard{&event};
       done = handle(event);
     }
-    doc_.root = doc_.values.root();
-    doc_.bytesRead = source_.bytesRead();
-    doc_.fnv1a = source_.hash();
-    return std::move(doc_);
   }
 
- private:
+  // Two threads: libyaml's scanner and parser (about four fifths of the reading) run on a thread
+  // of their own and hand over batches of events; this thread adds them to the tree (and frees
+  // them) while the next ones are parsed. The tree is built from the same events in the same
+  // order as runSerial builds it.
+  void runPipelined(yaml_parser_t& parser) {
+    EventPipe pipe;
+    std::thread producer([&] { pipe.produce(parser); });
+    struct Join {
+      EventPipe& pipe;
+      std::thread& thread;
+      ~Join() {
+        pipe.stop();
+        if (thread.joinable()) thread.join();
+        pipe.freeRemaining();
+      }
+    } join{pipe, producer};
+    std::size_t events = 0;
+    bool done = false;
+    std::vector<yaml_event_t> batch;
+    while (!done && pipe.next(batch)) {
+      for (std::size_t i = 0; i < batch.size(); ++i) {
+        EventGuard eventGuard{&batch[i]};
+        if (done) continue;  // events after the end: only freed
+        if (++events % kEventsPerPoll == 0) throwIfCancelled(cancel_);
+        try {
+          done = handle(batch[i]);
+        } catch (...) {
+          for (std::size_t j = i + 1; j < batch.size(); ++j) yaml_event_delete(&batch[j]);
+          throw;
+        }
+      }
+      batch.clear();
+    }
+    if (!done) {
+      // The producer stopped without the end of the stream: the parse failed.
+      pipe.stop();
+      producer.join();  // the failure is the parsing thread's; the source's flags too
+      fail(pipe.failure());
+    }
+  }
+
   // Returns true when reading can stop: the end of the stream, or the start of a second document.
   bool handle(const yaml_event_t& e) {
     switch (e.type) {
@@ -286,6 +434,10 @@ class Reader {
                             (value.empty() || value == "~" || value == "null" || value == "Null" ||
                              value == "NULL");
         countValue(e.start_mark);
+        // A plain `<<` as a key is YAML's merge key: resolved when its mapping closes.
+        if (e.data.scalar.style == YAML_PLAIN_SCALAR_STYLE && value == "<<" && atKey()) {
+          mergeIn_.back() = true;
+        }
         const ValueId id = isNull ? doc_.values.addNull(positionOf(e.start_mark))
                                   : doc_.values.addScalar(value, positionOf(e.start_mark));
         added(id, e.data.scalar.anchor);
@@ -339,10 +491,66 @@ class Reader {
     added(id, anchor);
     open_[id] = true;
     stack_.push_back(id);
+    mergeIn_.push_back(false);
+  }
+
+  // Whether the next value is a key of the innermost open mapping.
+  bool atKey() const {
+    return !stack_.empty() && doc_.values.kind(stack_.back()) == ValueKind::Map &&
+           doc_.values.openChildren().size() % 2 == 0;
+  }
+
+  // YAML's merge keys (`<<: *base`, `<<: [*a, *b]`) in the innermost mapping: the entries of the
+  // mappings named join it, unless it has the key itself or an earlier merged mapping had it;
+  // they keep the places where they were written.
+  void resolveMergeKeys() {
+    const ValueTree& t = doc_.values;
+    const std::vector<ValueId> children = t.openChildren();
+    std::vector<ValueId> own, merged;
+    std::vector<std::string_view> present;
+    const auto isMergeKey = [&](ValueId key) { return t.isScalar(key) && t.scalar(key) == "<<"; };
+    for (std::size_t i = 0; i + 1 < children.size(); i += 2) {
+      if (isMergeKey(children[i])) continue;
+      own.push_back(children[i]);
+      own.push_back(children[i + 1]);
+      if (t.isScalar(children[i])) present.push_back(t.scalar(children[i]));
+    }
+    const auto mergeFrom = [&](ValueId map, ValueId where) {
+      if (!t.isMap(map)) {
+        throw SyntaxError(t.position(where),
+                          "a merge key '<<' takes a mapping or a list of mappings (an alias "
+                          "*name of one)",
+                          SyntaxError::Kind::Syntax);
+      }
+      for (std::size_t i = 0; i < t.size(map); ++i) {
+        const ValueId key = t.key(map, i);
+        if (isMergeKey(key)) continue;  // already resolved when that mapping closed
+        const std::string_view name = t.scalar(key);
+        if (t.isScalar(key) && std::find(present.begin(), present.end(), name) != present.end()) {
+          continue;
+        }
+        merged.push_back(key);
+        merged.push_back(t.value(map, i));
+        if (t.isScalar(key)) present.push_back(name);
+      }
+    };
+    for (std::size_t i = 0; i + 1 < children.size(); i += 2) {
+      if (!isMergeKey(children[i])) continue;
+      const ValueId value = children[i + 1];
+      if (t.isList(value)) {
+        for (std::size_t j = 0; j < t.size(value); ++j) mergeFrom(t.item(value, j), value);
+      } else {
+        mergeFrom(value, t.isNull(value) ? children[i] : value);
+      }
+    }
+    own.insert(own.end(), merged.begin(), merged.end());
+    doc_.values.replaceOpenChildren(own);
   }
 
   // A closed collection's weight: itself plus its children's (aliased subtrees included).
   void close() {
+    if (mergeIn_.back()) resolveMergeKeys();
+    mergeIn_.pop_back();
     const ValueId id = stack_.back();
     stack_.pop_back();
     doc_.values.close();
@@ -391,7 +599,7 @@ class Reader {
     doc_.values.attach(target);
   }
 
-  [[noreturn]] void fail(const yaml_parser_t& parser) {
+  [[noreturn]] void fail(const ParseFailure& parser) {
     if (source_.cancelled) throw Cancelled();
     if (source_.tooLarge()) {
       throw SyntaxError({}, "", SyntaxError::Kind::Refused);  // the caller words it
@@ -445,6 +653,7 @@ class Reader {
   Document doc_;
   int documents_ = 0;
   std::vector<ValueId> stack_;
+  std::vector<bool> mergeIn_;  // per open collection: it has a merge key `<<`
   std::unordered_map<std::string, ValueId> anchors_;
   // Per value: values of its subtree with aliases expanded (saturating), and whether it is open.
   std::vector<std::uint64_t> weight_;

@@ -60,8 +60,6 @@ struct Document {
   // Where a second document starts (a scene file holds exactly one); nothing after it is read.
   std::optional<TextPosition> secondDocument;
   std::uint64_t bytesRead = 0;
-  std::uint64_t fnv1a =
-      0;  // 64-bit FNV-1a hash of the bytes read (the whole text unless cut short)
 };
 
 // Reads the first document of `text`. Throws SyntaxError, or glint::Cancelled when `cancel` is set

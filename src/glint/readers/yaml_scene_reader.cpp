@@ -29,25 +29,61 @@ ValueId findKey(const ValueTree& tree, ValueId map, std::string_view key) {
   return kNoValue;
 }
 
+// The files being read through `include`, outermost first (to find cycles), and the cancel flag.
+struct IncludeState {
+  std::vector<std::filesystem::path> open;  // weakly canonical paths
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+// A YAML file read whole into a document; a file that cannot be opened throws SceneError (naming
+// only the file), one that is not YAML yaml::SyntaxError.
+yaml::Document readYamlFile(const std::filesystem::path& path, const std::string& name,
+                            const std::atomic<bool>* cancel);
+
+// The keys of a scene file's top level, and the ones an included file may hold too.
+const std::vector<std::string_view> kSceneKeys = {"name",   "background", "ambient",   "camera",
+                                                  "image",  "render",     "materials", "objects",
+                                                  "lights", "include"};
+const std::vector<std::string_view> kIncludedKeys = {"include", "materials"};
+
 // The sections of the top-level mapping as entities.
 class TopLevel {
  public:
-  TopLevel(SceneDescription& scene, std::uint32_t file, Diagnostics& sink)
+  TopLevel(SceneDescription& scene, std::uint32_t file, Diagnostics& sink, IncludeState& includes,
+           bool included = false)
       : scene_(scene),
         file_(file),
         source_(*scene.files[file]),
         reader_(source_.source(), sink),
-        sink_(sink) {}
+        sink_(sink),
+        includes_(includes),
+        included_(included) {}
 
   void read(ValueId root) {
     ParameterDictionary top(reader_, root, {"at the top level", "", "the scene"});
-    top.declare({"name", "background", "ambient", "camera", "image", "render", "materials",
-                 "objects", "lights"});
+    if (included_) {
+      // What only a scene file holds, named as such rather than as an unknown key.
+      top.declare(kIncludedKeys);
+      for (const std::string_view key : kSceneKeys) {
+        if (top.isDeclared(key) || !top.has(key)) continue;
+        top.error(top.keyPlace(key),
+                  fmt::format("'{}' belongs in the scene file: an included file holds materials "
+                              "and further includes only",
+                              key));
+        top.markUsed({key});
+      }
+      includes(top);
+      materials(top);
+      top.finish();
+      return;
+    }
+    top.declare(kSceneKeys);
     for (const char* key : {"camera", "image"}) {
       if (!top.has(key)) {
         sink_.error(startOf(source_), fmt::format("the scene is missing required key '{}'", key));
       }
     }
+    includes(top);
     if (const auto name = top.text("name")) scene_.name = name->where;
     section(top, "background", EntityKind::BackgroundEntity);
     section(top, "ambient", EntityKind::AmbientEntity);
@@ -104,6 +140,91 @@ class TopLevel {
     }
   }
 
+  // `include`: a file name or a list of them, each read as a file of materials (and includes) of
+  // its own; relative names start at this file's folder.
+  void includes(ParameterDictionary& top) {
+    const auto e = top.find("include");
+    if (!e || tree().isNull(e->value)) return;
+    std::vector<std::pair<ValueId, ValueId>> names;  // (value, place)
+    if (tree().isScalar(e->value)) {
+      names.emplace_back(e->value, e->value);
+    } else if (tree().isList(e->value)) {
+      for (std::size_t i = 0; i < tree().size(e->value); ++i) {
+        names.emplace_back(tree().item(e->value, i), reader_.itemPlace(e->value, e->where, i));
+      }
+    } else {
+      top.error(e->where, fmt::format("include: expected a file name or a list of file names, "
+                                      "got {}",
+                                      reader_.describe(e->value)));
+      return;
+    }
+    for (const auto& [value, place] : names) {
+      if (!tree().isScalar(value) || tree().scalar(value).empty()) {
+        reader_.error(
+            place, fmt::format("include: expected a file name, got {}", reader_.describe(value)));
+        continue;
+      }
+      include(std::string(tree().scalar(value)), place);
+    }
+  }
+
+  void include(const std::string& written, ValueId place) {
+    namespace fs = std::filesystem;
+    const fs::path path = fs::path(written).is_relative()
+                              ? (source_.baseDirectory / written).lexically_normal()
+                              : fs::path(written);
+    std::error_code ignored;
+    const fs::path identity = fs::weakly_canonical(path, ignored);
+    for (std::size_t i = 0; i < includes_.open.size(); ++i) {
+      if (includes_.open[i] != identity) continue;
+      std::string chain;
+      for (std::size_t j = i; j < includes_.open.size(); ++j) {
+        chain += includes_.open[j].filename().string() + " -> ";
+      }
+      reader_.error(place, fmt::format("include cycle: {}{}", escapeForMessage(chain),
+                                       escapeForMessage(identity.filename().string())));
+      return;
+    }
+    const std::string name = path.string();
+    yaml::Document document;
+    try {
+      document = readYamlFile(path, name, includes_.cancel);
+    } catch (const SceneError& e) {
+      std::string reason = e.diagnostics().empty() ? e.what() : e.diagnostics()[0].message;
+      if (reason.rfind("cannot open file: ", 0) == 0) reason.erase(0, 18);
+      reader_.error(place,
+                    fmt::format("cannot include '{}': {}", escapeForMessage(written), reason));
+      return;
+    } catch (const yaml::SyntaxError& e) {
+      // The file joins the description all the same, so its errors sort after its includer's.
+      scene_.addFile(name, path.parent_path());
+      const TextPosition p = e.where();
+      sink_.error({name, p.line == 0 ? 1 : static_cast<int>(p.line),
+                   p.line == 0 ? 1 : static_cast<int>(p.column)},
+                  e.what());
+      return;
+    }
+    SourceFile& file = scene_.addFile(name, path.parent_path());
+    file.values = std::move(document.values);
+    file.bytes = document.bytesRead;
+    const auto index = static_cast<std::uint32_t>(scene_.files.size() - 1);
+    if (document.secondDocument) {
+      sink_.error(file.location(kNoValue),
+                  "the file holds more than one YAML document; an included file holds exactly one");
+    }
+    const ValueId root = document.root;
+    if (file.values.isNull(root)) return;  // an empty file includes nothing
+    if (!file.values.isMap(root)) {
+      sink_.error({name, 1, 1}, fmt::format("an included file must be a mapping of materials, "
+                                            "got {}",
+                                            ValueReader(file.source(), sink_).describe(root)));
+      return;
+    }
+    includes_.open.push_back(identity);
+    TopLevel(scene_, index, sink_, includes_, true).read(root);
+    includes_.open.pop_back();
+  }
+
   // `objects`, `lights`: lists of entities.
   void list(ParameterDictionary& top, std::string_view key, std::string_view what,
             EntityKind kind) {
@@ -124,11 +245,13 @@ class TopLevel {
   const SourceFile& source_;
   ValueReader reader_;
   Diagnostics& sink_;
+  IncludeState& includes_;
+  bool included_;
 };
 
 // The read document → entities, or the one error that stopped the reading.
 ParseResult describe(SceneDescription scene, yaml::Document* document,
-                     const yaml::SyntaxError* failure) {
+                     const yaml::SyntaxError* failure, const std::atomic<bool>* cancel) {
   ParseResult result;
   Diagnostics sink;
   SourceFile& file = *scene.files[0];
@@ -141,7 +264,6 @@ ParseResult describe(SceneDescription scene, yaml::Document* document,
     sink.error(at(failure->where()), failure->what());
   } else {
     file.values = std::move(document->values);
-    file.fnv1a = document->fnv1a;
     file.bytes = document->bytesRead;
     if (document->secondDocument) {
       sink.error(at(*document->secondDocument),
@@ -157,7 +279,10 @@ ParseResult describe(SceneDescription scene, yaml::Document* document,
                                             "image, objects, ...), got {}",
                                             reader.describe(root)));
     } else {
-      TopLevel(scene, 0, sink).read(root);
+      IncludeState includes{{}, cancel};
+      std::error_code ignored;
+      includes.open.push_back(std::filesystem::weakly_canonical(file.name, ignored));
+      TopLevel(scene, 0, sink, includes).read(root);
     }
   }
   scene.complete = !sink.hasErrors();
@@ -180,14 +305,16 @@ ParseResult parseScene(std::string_view text, const std::string& file,
   SceneDescription scene = emptyScene(file, baseDirectory);
   try {
     yaml::Document document = yaml::read(text, {}, cancel);
-    return describe(std::move(scene), &document, nullptr);
+    return describe(std::move(scene), &document, nullptr, cancel);
   } catch (const yaml::SyntaxError& e) {
-    return describe(std::move(scene), nullptr, &e);
+    return describe(std::move(scene), nullptr, &e, cancel);
   }
 }
 
-ParseResult readSceneFile(const std::filesystem::path& path, const std::string& name,
-                          const std::atomic<bool>* cancel) {
+namespace {
+
+yaml::Document readYamlFile(const std::filesystem::path& path, const std::string& name,
+                            const std::atomic<bool>* cancel) {
   const auto tooLarge = [&name]() {
     return SceneError({{Diagnostic::Severity::Error,
                         {name, 0, 0},
@@ -196,21 +323,32 @@ ParseResult readSceneFile(const std::filesystem::path& path, const std::string& 
   };
   const ReadableFile opened = openRegularFile(path, name);
   if (opened.size > kMaxSceneFileBytes) throw tooLarge();
-  std::filesystem::path base = path.parent_path();
-  if (base.empty()) base = ".";
-  SceneDescription scene = emptyScene(name, base);
   try {
-    yaml::Document document = yaml::readFile(opened.fd, kMaxSceneFileBytes, {}, cancel);
-    return describe(std::move(scene), &document, nullptr);
+    return yaml::readFile(opened.fd, kMaxSceneFileBytes, {}, cancel);
   } catch (const yaml::SyntaxError& e) {
     // A file that grew past the limit while it was read.
     if (e.kind() == yaml::SyntaxError::Kind::Refused && e.where().line == 0 && *e.what() == '\0') {
       throw tooLarge();
     }
-    return describe(std::move(scene), nullptr, &e);
+    throw;
   } catch (const std::system_error& e) {
     throw SceneError(
         {{Diagnostic::Severity::Error, {name, 0, 0}, "cannot open file: " + e.code().message()}});
+  }
+}
+
+}  // namespace
+
+ParseResult readSceneFile(const std::filesystem::path& path, const std::string& name,
+                          const std::atomic<bool>* cancel) {
+  std::filesystem::path base = path.parent_path();
+  if (base.empty()) base = ".";
+  SceneDescription scene = emptyScene(name, base);
+  try {
+    yaml::Document document = readYamlFile(path, name, cancel);
+    return describe(std::move(scene), &document, nullptr, cancel);
+  } catch (const yaml::SyntaxError& e) {
+    return describe(std::move(scene), nullptr, &e, cancel);
   }
 }
 

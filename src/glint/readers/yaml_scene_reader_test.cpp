@@ -745,3 +745,96 @@ TEST(SceneParser, UnreadableFilesNameOnlyTheFile) {
 
 }  // namespace
 }  // namespace glint
+
+namespace glint {
+namespace {
+
+// A folder of scene files for the include tests, removed afterwards.
+class IncludeFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("glint_include_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_ / "common");
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  void write(const std::string& name, const std::string& text) const {
+    std::ofstream(dir_ / name, std::ios::binary) << text;
+  }
+  // Every error of loading `name`, formatted, with the folder left out.
+  std::vector<std::string> errorsOf(const std::string& name) const {
+    std::vector<std::string> out;
+    try {
+      loadScene(dir_ / name);
+    } catch (const SceneError& e) {
+      for (const Diagnostic& d : e.diagnostics()) {
+        std::string text = d.format();
+        for (std::size_t at; (at = text.find(dir_.string() + "/")) != std::string::npos;) {
+          text.erase(at, dir_.string().size() + 1);
+        }
+        out.push_back(text);
+      }
+    }
+    return out;
+  }
+  std::filesystem::path dir_;
+};
+
+constexpr const char* kCameraImage =
+    "camera: {position: [0, 0, 5], direction: [0, 0, -1], fov: 40}\n"
+    "image: {width: 8, height: 6}\n";
+
+TEST_F(IncludeFiles, IncludedMaterialsJoinTheScene) {
+  write("scene.yaml", std::string("include: [common/paints.yaml]\n") + kCameraImage +
+                          "objects:\n"
+                          "  - {type: sphere, center: [0, 0, 0], radius: 1, material: red}\n"
+                          "  - {type: sphere, center: [2, 0, 0], radius: 1, material: blue}\n");
+  // Paths in an included file start at its own folder; includes nest.
+  write("common/paints.yaml", "include: more.yaml\nmaterials:\n  red: {kd: [1, 0, 0]}\n");
+  write("common/more.yaml", "materials:\n  blue: {kd: [0, 0, 1]}\n");
+  const LoadedScene s = loadScene(dir_ / "scene.yaml");
+  ASSERT_EQ(s.parts.primitives.size(), 2u);
+  EXPECT_EQ(s.parts.materials.at(s.parts.primitives[0].materialIndex()).kd, Color(1, 0, 0));
+  EXPECT_EQ(s.parts.materials.at(s.parts.primitives[1].materialIndex()).kd, Color(0, 0, 1));
+  // A single name works as a list of one; an empty included file brings nothing.
+  write("empty.yaml", "");
+  write("one.yaml", std::string("include: empty.yaml\n") + kCameraImage);
+  EXPECT_TRUE(errorsOf("one.yaml").empty());
+}
+
+TEST_F(IncludeFiles, ErrorsNameBothPlacesAndTheFileTheyAreIn) {
+  write("scene.yaml", std::string("include: [common/paints.yaml]\n") + kCameraImage +
+                          "materials:\n  red: {kd: 1}\n");
+  write("common/paints.yaml", "materials:\n  red: {kd: [1, 0, 0]}\n  bad: {kd: -1}\n");
+  EXPECT_EQ(
+      errorsOf("scene.yaml"),
+      (std::vector<std::string>{"scene.yaml:5:3: duplicate material 'red': defined twice (first at "
+                                "common/paints.yaml:2:3)",
+                                "common/paints.yaml:3:13: materials.bad.kd must be >= 0, got -1"}));
+}
+
+TEST_F(IncludeFiles, CyclesMissingFilesAndSceneKeysAreErrorsAtTheirPlace) {
+  write("a.yaml", std::string("include: [b.yaml, missing.yaml]\n") + kCameraImage);
+  write("b.yaml", "include: [a.yaml]\nmaterials: {m: {kd: 1}}\nobjects: []\n");
+  EXPECT_EQ(errorsOf("a.yaml"),
+            (std::vector<std::string>{
+                "a.yaml:1:19: cannot include 'missing.yaml': No such file or directory",
+                "b.yaml:1:11: include cycle: a.yaml -> b.yaml -> a.yaml",
+                "b.yaml:3:1: 'objects' belongs in the scene file: an included file holds "
+                "materials and further includes only"}));
+  write("c.yaml", std::string("include: [list.yaml, broken.yaml, {a: 1}]\n") + kCameraImage);
+  write("list.yaml", "- a\n");
+  write("broken.yaml", "materials: {m: {kd: [1, 2}\n");
+  const std::vector<std::string> errors = errorsOf("c.yaml");
+  ASSERT_EQ(errors.size(), 3u);
+  EXPECT_EQ(errors[0], "c.yaml:1:35: include: expected a file name, got a mapping");
+  EXPECT_EQ(errors[1],
+            "list.yaml:1:1: an included file must be a mapping of materials, got a "
+            "list of 1 item");
+  EXPECT_THAT(errors[2], HasSubstr("broken.yaml:1:26: syntax error: a '[' is not closed"));
+}
+
+}  // namespace
+}  // namespace glint
