@@ -25,6 +25,35 @@ TEST(PreviewMessages, Base64MatchesRfc4648TestVectors) {
   EXPECT_EQ(base64(high), "//4A");
 }
 
+// The table-driven encoder against the definition, six bits at a time, for every 12-bit group
+// (all byte pairs appear across the shifted runs) and every length's padding.
+TEST(PreviewMessages, Base64MatchesTheBitByBitDefinition) {
+  constexpr char kDigits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  const auto reference = [&](const std::vector<std::uint8_t>& bytes) {
+    std::string out;
+    for (std::size_t bit = 0; bit < bytes.size() * 8; bit += 6) {
+      int v = 0;
+      for (std::size_t b = bit; b < bit + 6; ++b)
+        v = v * 2 + (b < bytes.size() * 8 ? (bytes[b / 8] >> (7 - b % 8)) & 1 : 0);
+      out += kDigits[v];
+    }
+    while (out.size() % 4 != 0) out += '=';
+    return out;
+  };
+  std::vector<std::uint8_t> bytes;
+  for (int shift = 0; shift < 3; ++shift)
+    for (int a = 0; a < 256; ++a)
+      for (int b = 0; b < 256; b += 17) {
+        bytes.push_back(static_cast<std::uint8_t>(a));
+        bytes.push_back(static_cast<std::uint8_t>(b + shift));
+      }
+  EXPECT_EQ(base64(bytes), reference(bytes));
+  for (std::size_t length = 0; length < 8; ++length) {
+    const std::vector<std::uint8_t> part(bytes.begin() + 100, bytes.begin() + 100 + length);
+    EXPECT_EQ(base64(part), reference(part)) << length << " bytes";
+  }
+}
+
 TEST(PreviewMessages, JsonStringEscapesQuotesBackslashesAndControls) {
   EXPECT_EQ(jsonString("plain"), "\"plain\"");
   EXPECT_EQ(jsonString("a \"b\" \\ c\nd\te\x01"), "\"a \\\"b\\\" \\\\ c\\nd\\te\\u0001\"");
