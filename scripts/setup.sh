@@ -22,7 +22,8 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
 # What the Release build and the whole test suite need (CMakeLists.txt's find_package calls; the mesh
-# tests read Debian's assimp-testmodels).
+# tests read Debian's assimp-testmodels; `file` is for CPack's dpkg-shlibdeps step, which the .deb
+# test runs: tests/deb_package_test.sh).
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libyaml-dev libpng-dev libopenexr-dev libtbb-dev libcli11-dev libfmt-dev
@@ -31,7 +32,7 @@ PACKAGES=(
   libcpp-httplib-dev file
 )
 # The tests beyond the build: the preview page in headless Chromium through WebDriver
-# (tests/browser/); `file` is for CPack's dpkg-shlibdeps step (tests/deb_package_test.sh).
+# (tests/browser/, ctest preview_browser: skipped without them, but a failure under CI=true).
 TEST_PACKAGES=(chromium chromium-driver python3-selenium)
 # clang with its compiler-rt (libFuzzer, ASan, UBSan runtimes) for the fuzz targets.
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
