@@ -35,7 +35,7 @@ std::vector<PixelRegion> tilesOf(const PixelRegion& region, int size) {
   return tiles;
 }
 
-// Waits (the encoder runs on its own thread) until `done` holds for the changes since `since`.
+// Waits (the publisher runs on its own thread) until `done` holds for the changes since `since`.
 template <typename Done>
 PreviewChanges waitUntil(PreviewState& state, std::uint64_t since, Done done) {
   const auto deadline = std::chrono::steady_clock::now() + 10s;
