@@ -140,7 +140,8 @@ std::string tilesEvent(std::span<const PreviewTile> tiles, int width, int height
     writeBase64(tile.rgb, out.data() + at);
     out += "\"}";
   }
-  return out + "]}\n\n";
+  out += "]}\n\n";
+  return out;  // not `out + ...`: that would copy the whole event
 }
 
 }  // namespace glint
