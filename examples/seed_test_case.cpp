@@ -11,8 +11,7 @@
 #include <string>
 #include <utility>
 
-#include "glint/job/render_job.h"
-#include "glint/scene/seed_scene.h"
+#include "glint/glint.h"
 
 int main(int argc, char** argv) {
   glint::RenderJobSpec job;

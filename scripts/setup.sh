@@ -3,7 +3,8 @@
 #
 #   scripts/setup.sh render   install dependencies, build Release, render scenes/showcase.yaml
 #                             to ./showcase.png (in the current folder)
-#   scripts/setup.sh test     install dependencies, build Release, run every test (ctest)
+#   scripts/setup.sh test     install dependencies and the test browser (Chromium, chromedriver,
+#                             Selenium), build Release, run every test (ctest)
 #   scripts/setup.sh deps     only install the dependencies (the default with no command)
 #   scripts/setup.sh build    install dependencies and build Release (build/, binary build/glint)
 #   scripts/setup.sh bench    also install Embree, Tachyon and POV-Ray; build Release with the
@@ -21,19 +22,25 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
 # What the Release build and the whole test suite need (CMakeLists.txt's find_package calls; the mesh
-# tests read Debian's assimp-testmodels; OpenMPI for rendering across processes and its mpirun tests).
+# tests read Debian's assimp-testmodels; OpenMPI for rendering across processes and its mpirun tests;
+# `file` is for CPack's dpkg-shlibdeps step, which the .deb test runs: tests/deb_package_test.sh).
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libyaml-dev libpng-dev libjpeg62-turbo-dev libopenexr-dev libtbb-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libassimp-dev assimp-testmodels
   libopenmpi-dev openmpi-bin
+  libcpp-httplib-dev file
 )
+# The tests beyond the build: the preview page in headless Chromium through WebDriver
+# (tests/browser/, ctest preview_browser: skipped without them, but a failure under CI=true).
+TEST_PACKAGES=(chromium chromium-driver python3-selenium)
 # clang with its compiler-rt (libFuzzer, ASan, UBSan runtimes) for the fuzz targets.
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
 # The benchmarks' references: Embree 3 (linked by bench/ only), the Tachyon and POV-Ray renderers;
-# python3 for bench/spd_bench.sh's NFF-to-Tachyon converter and image comparison.
-BENCH_PACKAGES=(libembree-dev libbenchmark-dev tachyon povray python3)
+# python3 for bench/spd_bench.sh's NFF-to-Tachyon converter and image comparison; matplotlib draws
+# the benchmark plots in docs/images/ (scripts/plot_benchmarks.py).
+BENCH_PACKAGES=(libembree-dev libbenchmark-dev tachyon povray python3 python3-matplotlib)
 
 log() { printf 'setup: %s\n' "$*" >&2; }
 die() {
@@ -41,7 +48,7 @@ die() {
   exit 1
 }
 
-usage() { sed -n '2,19s/^# \{0,1\}//p' "${BASH_SOURCE[0]}"; }
+usage() { sed -n '2,20s/^# \{0,1\}//p' "${BASH_SOURCE[0]}"; }
 
 command_name=deps
 with_fuzz=0
@@ -66,6 +73,7 @@ wanted_packages() {
   local packages=("${PACKAGES[@]}")
   ((with_fuzz)) && packages+=("${FUZZ_PACKAGES[@]}")
   [[ "$command_name" == bench ]] && packages+=("${BENCH_PACKAGES[@]}")
+  [[ "$command_name" == test ]] && packages+=("${TEST_PACKAGES[@]}")
   printf '%s\n' "${packages[@]}"
 }
 

@@ -4,8 +4,10 @@
 //   mesh uses readers, scene and below; image (files of pictures) uses render's Film and below;
 //   factories turn entities into scene parts; writers write scene descriptions (readers' entities)
 //   as YAML; job runs renders and conversions; cluster spreads a job's render over MPI ranks
-//   (above job: it hooks the job's render step, and the job must not know MPI); cli only turns
-//   arguments into jobs.
+//   (above job: it hooks the job's render step, and the job must not know MPI); preview serves a
+//   running job's picture over HTTP (it consumes job events, so it sits above job); cli only turns
+//   arguments into jobs; glint/glint.h, the umbrella header, includes the public API of every
+//   module but cluster (built only with MPI).
 // Tests (*_test.cpp) may use anything.
 #include <gtest/gtest.h>
 
@@ -39,9 +41,15 @@ const std::map<std::string, std::set<std::string>>& allowedModules() {
       {"cluster",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
         "writers", "job", "cluster"}},
+      {"preview",
+       {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
+        "writers", "job", "preview"}},
       {"cli",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
-        "writers", "job", "cluster", "cli"}},
+        "writers", "job", "cluster", "preview", "cli"}},
+      {"glint",
+       {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
+        "writers", "job", "preview"}},
   };
   return allowed;
 }

@@ -25,12 +25,15 @@
 #include <utility>
 #include <vector>
 
+#include "glint/cli/preview_session.h"
 #include "glint/cli/progress_reporter.h"
 #include "glint/cli/signal_guard.h"
 #include "glint/job/job_error.h"
 #include "glint/job/render_job.h"
 #include "glint/job/scene_check.h"
 #include "glint/job/scene_convert.h"
+#include "glint/preview/preview_server.h"
+#include "glint/preview/preview_state.h"
 #include "glint/readers/diagnostics.h"
 #include "glint/render/film.h"
 #include "glint/render/renderer.h"
@@ -76,6 +79,7 @@ struct RenderArgs {
   std::optional<std::string> checkpoint, resume;  // checkpoint files
   bool quiet = false;
   bool stats = false;
+  std::optional<PreviewRequest> preview;  // --preview and its options
 };
 
 // --- argument checks ------------------------------------------------------------------------
@@ -219,7 +223,8 @@ std::string regionText(const SceneFacts& scene, const std::optional<PixelRegion>
   return text;
 }
 
-void printSummary(const RenderJobResult& result) {
+// What the render wrote, how long it took and what it traced (printed, and shown by the preview).
+std::string summaryText(const RenderJobResult& result) {
   const SceneFacts& scene = result.scene;
   const RenderStats& stats = result.stats;
   const RayCounts& rays = stats.rays;
@@ -253,7 +258,7 @@ void printSummary(const RenderJobResult& result) {
         stats.tilesResumed, result.tilesTotal,
         result.resumedFrom ? result.resumedFrom->string() : std::string(),
         result.tilesTotal - stats.tilesResumed);
-  emit(stderr, text);
+  return text;
 }
 
 void printStats(const RenderJobResult& result, int threads) {
@@ -414,23 +419,43 @@ int renderAndReport(RenderJobSpec spec, const RenderArgs& args, SignalGuard& sig
   };
   // A second signal must not end the process with a temporary file left behind.
   events.committing = [&signals](bool committing) { signals.setCommitting(committing); };
+  std::optional<PreviewSession> preview;
+  if (args.preview) {
+    try {
+      preview.emplace(*args.preview, args.scene, stderr);
+    } catch (const PreviewError& error) {
+      throw CliError(kExitBadInput, error.what());
+    }
+    preview->attach(events);
+  }
 
   RenderJobResult result;
   try {
     result = runRenderJob(std::move(spec), events);
   } catch (const JobError& error) {
-    return reportJobError(error, args.scene);
+    const int status = reportJobError(error, args.scene);
+    if (preview)
+      preview->end(PreviewPhase::Failed,
+                   *error.what() ? error.what() : "the scene has errors (see the terminal)",
+                   signals.cancelFlag());
+    return status;
   }
-  if (result.outcome == RenderJobResult::Outcome::Interrupted) return reportInterrupted(result);
+  if (result.outcome == RenderJobResult::Outcome::Interrupted) {
+    const int status = reportInterrupted(result);
+    if (preview) preview->end(PreviewPhase::Interrupted, "interrupted", signals.cancelFlag());
+    return status;
+  }
   if (!result.checkpointRemovalError.empty() && !args.quiet)
     emit(stderr, fmt::format("glint: warning: cannot remove the checkpoint '{}': {}\n",
                              args.checkpoint ? *args.checkpoint : *args.resume,
                              result.checkpointRemovalError));
+  const std::string summary = summaryText(result);
   if (!args.quiet) {
-    printSummary(result);
+    emit(stderr, summary);
     if (args.stats) printStats(result, threads);
     if (args.stats && moreStats) emit(stderr, moreStats());
   }
+  if (preview) preview->end(PreviewPhase::Finished, summary, signals.cancelFlag());
   return kExitSuccess;
 }
 
@@ -530,6 +555,7 @@ int runCommandLine(int argc, char** argv) {
           ->type_name("FILE");
   render->add_flag("--quiet", args.quiet, "No progress and no summary; errors only");
   render->add_flag("--stats", args.stats, "More statistics at the end");
+  const PreviewOptions previewOptions(*render);
 
   std::string checkFile;
   CLI::App* check =
@@ -594,6 +620,11 @@ int runCommandLine(int argc, char** argv) {
   args.maxMemory = given(maxMemoryOption, maxMemory);
   args.checkpoint = given(checkpointOption, checkpoint);
   args.resume = given(resumeOption, resume);
+  try {
+    args.preview = previewOptions.request();
+  } catch (const PreviewError& error) {
+    throw CliError(kExitBadInput, error.what());
+  }
 
   if (check->parsed()) return runCheck(checkFile);
   if (convert->parsed()) return runConvert(convertFile, convertOutput);

@@ -139,6 +139,7 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
       spec.crop.value_or(PixelRegion{0, 0, scene.image().width, scene.image().height});
   const std::vector<PixelRegion> tiles = tileRegions(region, options.tileSize);
   result.tilesTotal = tiles.size();
+  if (events.sceneBuilt) events.sceneBuilt(result.scene, region);
 
   // Checkpointing: the fingerprint of this render, the checkpoint it continues, the collector.
   std::optional<Checkpoint> resumed;
@@ -240,6 +241,7 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
 
   // The image is complete; the writer commits it atomically (temporary file, rename), polling the
   // cancel flag between rows.
+  if (events.imageFinished) events.imageFinished(film);
   {
     const Committing committing(events);
     phase = Clock::now();

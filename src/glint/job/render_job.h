@@ -74,6 +74,9 @@ struct FinishedTile {
 struct RenderJobEvents {
   // The scene's warnings (FILE:LINE:COL), once it is loaded, before anything else is done.
   std::function<void(const std::vector<Diagnostic>&)> sceneWarnings;
+  // The scene is built: what will be rendered, and the region of the image rendered (the crop, or
+  // all of it).
+  std::function<void(const SceneFacts&, const PixelRegion&)> sceneBuilt;
   // Rendering begins: tiles taken from the checkpoint, tiles in all.
   std::function<void(std::size_t, std::size_t)> renderStarting;
   // After each finished tile: (tiles done, tiles in all).
@@ -82,6 +85,8 @@ struct RenderJobEvents {
   std::function<void(const FinishedTile&)> tileFinished;
   // The render returned, finished or stopped.
   std::function<void()> renderEnded;
+  // The finished image as it will be written (grid included), just before the write.
+  std::function<void(const Film&)> imageFinished;
   // A periodic checkpoint save failed (reported once; the render goes on); worded for the user.
   std::function<void(const std::string&)> checkpointSaveFailed;
   // True while the job commits a file (a checkpoint, the image): the caller should not end the

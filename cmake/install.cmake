@@ -1,0 +1,53 @@
+# Installation and packaging (DESIGN.md §14). `cmake --install build [--prefix P]` puts in place:
+#   bin/glint                                the command            (component runtime)
+#   lib/libglint.a, include/glint/           the library, headers   (component dev)
+#   lib/cmake/glint/                         find_package(glint CONFIG) -> glint::glint (dev)
+# `cpack --config build/CPackConfig.cmake` makes two .debs: glint (the command; its Depends from
+# dpkg-shlibdeps) and libglint-dev (library, headers, package; Depends on the -dev packages that
+# glintConfig.cmake finds, and on glint for the same version).
+include(CMakePackageConfigHelpers)
+
+install(TARGETS glint_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+install(TARGETS glint EXPORT glintTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
+# Every library header (glint/glint.h includes the public API); not the command's, not tests'.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/glint/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/glint
+        COMPONENT dev FILES_MATCHING PATTERN "*.h"
+        PATTERN "*_test_support.h" EXCLUDE PATTERN "cli" EXCLUDE
+        PATTERN "cluster" EXCLUDE)  # built only with MPI, into the command alone
+
+set(GLINT_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/glint)
+install(EXPORT glintTargets NAMESPACE glint:: DESTINATION ${GLINT_CMAKE_DIR} COMPONENT dev)
+configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/glintConfig.cmake.in
+                              ${PROJECT_BINARY_DIR}/glintConfig.cmake
+                              INSTALL_DESTINATION ${GLINT_CMAKE_DIR})
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/glintConfigVersion.cmake
+                                 COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/glintConfig.cmake ${PROJECT_BINARY_DIR}/glintConfigVersion.cmake
+        DESTINATION ${GLINT_CMAKE_DIR} COMPONENT dev)
+
+set(CPACK_PACKAGE_NAME glint)
+set(CPACK_PACKAGE_VENDOR "glint")
+set(CPACK_PACKAGE_CONTACT "glint maintainers <glint@localhost>")
+set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
+set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+set(CPACK_GENERATOR DEB)
+set(CPACK_DEB_COMPONENT_INSTALL ON)
+set(CPACK_COMPONENTS_ALL runtime dev)
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SECTION graphics)
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME glint)
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
+# Each description: the summary line, then the long text (one string: a CMake list would show ';').
+set(CPACK_DEBIAN_RUNTIME_DESCRIPTION "fast, exact Whitted ray tracer for YAML scene files
+Renders scenes of shapes, triangle meshes (OBJ, PLY, STL, glTF), lights and materials to PNG, PPM
+or OpenEXR on every core, with a live preview in the browser.")
+set(CPACK_DEBIAN_DEV_PACKAGE_NAME libglint-dev)
+set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
+set(CPACK_DEBIAN_DEV_DESCRIPTION "glint ray tracer: static library, headers and CMake package
+find_package(glint CONFIG) gives the target glint::glint.")
+# What glintConfig.cmake finds (find_dependency, pkg-config), as Debian packages.
+set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
+    "glint (= ${PROJECT_VERSION}), cmake, pkg-config, libtbb-dev, libfmt-dev, libpng-dev, \
+libjpeg62-turbo-dev, libopenexr-dev, libassimp-dev, libyaml-dev, libcpp-httplib-dev")
+include(CPack)

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# The .debs that CPack makes: glint (the command) and libglint-dev (library, headers, CMake
+# package). Checks their control fields — glint's Depends come from dpkg-shlibdeps and name the
+# shared libraries it links — and unpacks glint into a scratch root, where `glint --version` and a
+# small render run. (Installing them — dpkg -i, apt-get -f install — changes the machine, so that
+# is described in docs/developing.md rather than done here.)
+#
+#   deb_package_test.sh BUILD_DIR SOURCE_DIR
+set -euo pipefail
+
+build="$(cd "$1" && pwd)"
+source="$(cd "$2" && pwd)"
+work="$(mktemp -d "${TMPDIR:-/tmp}/glint-deb-XXXXXX")"
+trap 'rm -rf "$work"' EXIT
+fail() {
+  printf 'FAIL: %s\n' "$*" >&2
+  exit 1
+}
+
+(cd "$work" && cpack --config "$build/CPackConfig.cmake" -B "$work/packages" >"$work/cpack.log") || {
+  cat "$work/cpack.log"
+  fail "cpack failed"
+}
+runtime="$(find "$work/packages" -maxdepth 1 -name 'glint_*.deb')"
+dev="$(find "$work/packages" -maxdepth 1 -name 'libglint-dev_*.deb')"
+[[ -f "$runtime" && -f "$dev" ]] || fail "expected glint_*.deb and libglint-dev_*.deb, got: $(ls "$work/packages")"
+
+depends="$(dpkg-deb -f "$runtime" Depends)"
+echo "glint Depends: $depends"
+for library in libc6 libstdc++6 libtbb libassimp libpng libopenexr libyaml libcpp-httplib; do
+  grep -q "$library" <<<"$depends" || fail "glint's Depends lack $library"
+done
+dev_depends="$(dpkg-deb -f "$dev" Depends)"
+echo "libglint-dev Depends: $dev_depends"
+grep -q "glint (= " <<<"$dev_depends" || fail "libglint-dev does not depend on glint"
+runtime_files="$(dpkg-deb -c "$runtime")"
+dev_files="$(dpkg-deb -c "$dev")"
+grep -q '\./usr/bin/glint$' <<<"$runtime_files" || fail "no /usr/bin/glint in the package"
+grep -q 'usr/include/glint/glint.h$' <<<"$dev_files" || fail "no glint.h in libglint-dev"
+grep -q 'cmake/glint/glintConfig.cmake$' <<<"$dev_files" || fail "no CMake package in libglint-dev"
+grep -q 'libglint\.a$' <<<"$dev_files" || fail "no libglint.a in libglint-dev"
+
+dpkg-deb -x "$runtime" "$work/root"
+"$work/root/usr/bin/glint" --version | grep -q '^glint ' || fail "the unpacked glint does not run"
+"$work/root/usr/bin/glint" render "$source/tests/cli/small.yaml" -o "$work/small.png" --quiet
+[[ -s "$work/small.png" ]] || fail "the unpacked glint did not render"
+echo "ok: $(basename "$runtime") and $(basename "$dev")"

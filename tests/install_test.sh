@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# glint as another project sees it once installed: `cmake --install` into a fresh prefix, then the
+# examples/ folder configured on its own against that prefix (find_package(glint CONFIG), which
+# finds glint's dependencies itself), built, and the seed's test case rendered — the same bytes as
+# the in-tree example's. examples/seed_test_case.cpp includes only glint/glint.h.
+#
+#   install_test.sh BUILD_DIR SOURCE_DIR
+set -euo pipefail
+
+build="$(cd "$1" && pwd)"
+source="$(cd "$2" && pwd)"
+work="$(mktemp -d "${TMPDIR:-/tmp}/glint-install-XXXXXX")"
+trap 'rm -rf "$work"' EXIT
+prefix="$work/prefix"
+fail() {
+  printf 'FAIL: %s\n' "$*" >&2
+  exit 1
+}
+
+cmake --install "$build" --prefix "$prefix" >"$work/install.log"
+[[ -x "$prefix/bin/glint" ]] || fail "no bin/glint in the prefix"
+"$prefix/bin/glint" --version
+[[ -f "$prefix/include/glint/glint.h" ]] || fail "no include/glint/glint.h"
+config="$(find "$prefix" -name glintConfig.cmake)"
+[[ -n "$config" ]] || fail "no glintConfig.cmake"
+archive="$(find "$prefix" -name libglint.a)"
+[[ -n "$archive" ]] || fail "no libglint.a"
+! grep -rlE 'gtest|gmock' "$prefix/include" || fail "test headers were installed"
+[[ ! -e "$prefix/include/glint/cli" ]] || fail "the command's headers were installed"
+echo "installed: $(cd "$prefix" && find . -type f | wc -l) files (${config#"$prefix"/}, ${archive#"$prefix"/})"
+
+generator=()
+command -v ninja >/dev/null && generator=(-G Ninja)
+cmake -S "$source/examples" -B "$work/examples" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$prefix" >"$work/configure.log" || {
+  cat "$work/configure.log"
+  fail "examples/ does not configure against the installed package"
+}
+cmake --build "$work/examples" -j "${GLINT_JOBS:-2}" --target seed_test_case
+"$work/examples/seed_test_case" "$work/seed.png"
+"$build/examples/seed_test_case" "$work/seed-in-tree.png" >/dev/null
+cmp "$work/seed.png" "$work/seed-in-tree.png" ||
+  fail "the example built against the installed package renders other bytes than the in-tree one"
+echo "ok: examples/ built against the installed glint renders the seed's test case"
