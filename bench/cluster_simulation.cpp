@@ -110,7 +110,7 @@ MeasuredTiles measureTiles(const Settings& settings) {
   options.threads = 1;
   options.tileSize = kMeasuredTile;
   double last = threadCpuSeconds();
-  options.tileFinished = [&](std::size_t tile, const glint::Film&) {
+  options.tileFinished = [&](std::size_t tile, const glint::Film&, int) {
     const double now = threadCpuSeconds();
     measured.seconds[tile] = now - last;
     last = now;

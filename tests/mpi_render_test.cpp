@@ -10,6 +10,8 @@
 #include <cstdlib>
 #include <regex>
 
+#include <httplib.h>
+
 #include "cli_harness.h"
 
 namespace glint_cli_test {
@@ -258,6 +260,29 @@ TEST_F(Mpi, AKilledRankFailsTheJobAndTheResumeRendersOnlyTheRest) {
     rendered += std::stoi((*it)[1]);
   EXPECT_EQ(rendered, totalTiles - resumedTiles) << resumed.err;
   EXPECT_EQ(filesIn(work_), (std::set<std::string>{"plain.png", "out.png"}));
+}
+
+TEST_F(Mpi, ThePreviewShowsWhichRankRenderedEachTile) {
+  // Rank 0 serves the page; the tiles of both ranks reach it, each marked with its rank.
+  const pid_t launcherPid = startCommand(
+      launcher(2) + glint(kShowcaseSmall + std::vector<std::string>{"--threads", "1", "-o",
+                                                                    "out.png", "--preview", "0"}));
+  ASSERT_TRUE(awaitStderr(std::regex("glint: the preview stays at http://127\\.0\\.0\\.1:"), 120s))
+      << stderrSoFar();
+  std::smatch port;
+  const std::string err = stderrSoFar();
+  ASSERT_TRUE(std::regex_search(err, port, std::regex(R"(preview at http://127\.0\.0\.1:(\d+)/)")))
+      << err;
+  httplib::Client client("127.0.0.1", std::stoi(port[1]));
+  std::string events;
+  client.Get("/events", [&events](const char* data, std::size_t length) {
+    events.append(data, length);
+    return events.find("\"phase\":\"finished\"") == std::string::npos;
+  });
+  kill(launcherPid, SIGINT);  // ends serving
+  finish(launcherPid, 30s);
+  EXPECT_TRUE(contains(events, "\"rank\":0,")) << events.substr(0, 1000);
+  EXPECT_TRUE(contains(events, "\"rank\":1,")) << events.substr(0, 1000);
 }
 
 TEST_F(Mpi, InterruptingMpirunSavesTheCheckpoint) {

@@ -74,7 +74,7 @@ Leg renderLeg(const Scene& scene, const std::optional<PixelRegion>& crop, int th
   options.cancel = &cancel;
   options.resumeFilm = &from.film;
   options.resumeTiles = &from.tiles;
-  options.tileFinished = [&](std::size_t tile, const Film& film) {
+  options.tileFinished = [&](std::size_t tile, const Film& film, int) {
     collector.addTile(tile, film);
     if (++finished == stopAfter) cancel.store(true);
   };

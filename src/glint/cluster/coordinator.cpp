@@ -88,7 +88,7 @@ class Assembly {
         for (int x = t.x0; x < t.x1; ++x) film_.at(x - region.x0, y - region.y0) = (*pixels)[i++];
     }
     ++done_;
-    if (options_.tileFinished) options_.tileFinished(tile, film_);
+    if (options_.tileFinished) options_.tileFinished(tile, film_, rank);
     if (options_.progress) options_.progress(done_, tiles_.size());
     assigned = scheduler_.assign(rank, next);
     return true;
@@ -269,7 +269,7 @@ void Coordinator::render(const Scene& scene, const RenderOptions& options, Film&
   local.tiles.reset();
   local.cancel = &stopLocal;
   local.nextTile = [&feed] { return feed.next(); };
-  local.tileFinished = [&](std::size_t tile, const Film&) {
+  local.tileFinished = [&](std::size_t tile, const Film&, int) {
     TileList next;
     assembly.finish(0, static_cast<std::uint32_t>(tile), nullptr, 1, next);
     feed.push(next);

@@ -69,7 +69,7 @@ class TileRender {
     options_.tileSize = spec.tileSize;
     options_.cancel = &stop_;
     options_.nextTile = [this] { return feed_.next(); };
-    options_.tileFinished = [this, &link](std::size_t tile, const Film& film) {
+    options_.tileFinished = [this, &link](std::size_t tile, const Film& film, int) {
       link.send(0, Tag::Tile, encodeTile(static_cast<std::uint32_t>(tile), tiles_[tile], film));
       ++tilesDone_;
     };

@@ -188,10 +188,12 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
   if (events.progress) options.progress = events.progress;
   bool saveFailed = false;  // report once, not at every periodic save
   if (collector || events.tileFinished) {
-    options.tileFinished = [&](std::size_t tile, const Film& film) {
+    options.tileFinished = [&](std::size_t tile, const Film& film, int rank) {
       ++tilesDone;
-      if (events.tileFinished)
-        events.tileFinished(FinishedTile{tile, tiles[tile], film, tilesDone, tiles.size()});
+      if (events.tileFinished) {
+        events.tileFinished(FinishedTile{tile, tiles[tile], film, tilesDone, tiles.size(),
+                                         rank < 0 ? std::nullopt : std::optional<int>(rank)});
+      }
       if (!collector) return;
       collector->addTile(tile, film);
       // After a stop request the checkpoint is saved once, when the render has returned.

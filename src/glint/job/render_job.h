@@ -65,8 +65,9 @@ struct FinishedTile {
   std::size_t index = 0;  // in tileRegions(region, tileSize)
   PixelRegion region;     // its pixels, in full-image coordinates
   const Film& film;  // the render's film: the pixels inside `region` are final (before the grid)
-  std::size_t done = 0;   // tiles finished so far (resumed ones included) ...
-  std::size_t total = 0;  // ... of this many
+  std::size_t done = 0;     // tiles finished so far (resumed ones included) ...
+  std::size_t total = 0;    // ... of this many
+  std::optional<int> rank;  // the MPI rank that rendered it (none outside MPI)
 };
 
 // What a caller hears while the job runs. Every callback is optional. They are called on the

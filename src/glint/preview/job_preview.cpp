@@ -19,7 +19,7 @@ void attachPreview(RenderJobEvents& events, PreviewState& state) {
   events.tileFinished = [&state,
                          before = std::move(events.tileFinished)](const FinishedTile& tile) {
     if (before) before(tile);
-    state.tileFinished(tile.region, tile.film, tile.done, tile.total);
+    state.tileFinished(tile.region, tile.film, tile.done, tile.total, tile.rank);
   };
   events.imageFinished = [&state, before = std::move(events.imageFinished)](const Film& film) {
     if (before) before(film);

@@ -772,7 +772,7 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
       firstNonFinite = tileFirstNonFinite;
     }
     ++tilesDone;
-    if (options.tileFinished) options.tileFinished(tile, film);
+    if (options.tileFinished) options.tileFinished(tile, film, -1);
     if (options.progress) options.progress(tilesDone, tileCount);
   };
 

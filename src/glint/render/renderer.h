@@ -55,9 +55,10 @@ struct RenderOptions {
   // (tiles done, tiles total).
   std::function<void(std::size_t, std::size_t)> progress;
   // Called (serialised with `progress`, from the worker that finished the tile) after each rendered
-  // tile with its index in tileRegions(region, tileSize) and the film, whose pixels inside that
-  // tile are final (no grid overlay yet). Checkpointing hooks here.
-  std::function<void(std::size_t, const Film&)> tileFinished;
+  // tile with its index in tileRegions(region, tileSize), the film, whose pixels inside that tile
+  // are final (no grid overlay yet), and the MPI rank that rendered it (−1: this process, outside
+  // MPI; the cluster's render step passes each tile's rank). Checkpointing hooks here.
+  std::function<void(std::size_t tile, const Film& film, int rank)> tileFinished;
   // Resume: when both are set, every tile i with (*resumeTiles)[i] true is copied from *resumeFilm
   // (which must cover the same region) instead of rendered. Same scene and options as the earlier
   // run give the same bytes as an uninterrupted render.

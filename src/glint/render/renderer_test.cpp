@@ -190,7 +190,10 @@ TEST(Renderer, TileSubsetsAndTheFeedIntoOneFilmEqualTheWholeRender) {
   for (std::size_t tile = tileCount; tile-- > 0;)
     if (tile % 2 == 1) odd.tiles->push_back(tile);
   std::vector<std::size_t> finished;
-  odd.tileFinished = [&finished](std::size_t tile, const Film&) { finished.push_back(tile); };
+  odd.tileFinished = [&finished](std::size_t tile, const Film&, int rank) {
+    EXPECT_EQ(rank, -1);  // not an MPI rank's
+    finished.push_back(tile);
+  };
   Film film(21, 13, expected.region());
   const Color marker(7, 7, 7);
   for (int y = 0; y < film.height(); ++y)
@@ -600,7 +603,7 @@ TEST(Renderer, CancelStopsInsideATileWithoutReportingIt) {
   options.tileSize = 64;
   std::size_t reports = 0;
   options.progress = [&](std::size_t, std::size_t) { ++reports; };
-  options.tileFinished = [&](std::size_t, const Film&) { ++reports; };
+  options.tileFinished = [&](std::size_t, const Film&, int) { ++reports; };
   std::thread canceller([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     cancel = true;
