@@ -12,6 +12,7 @@ namespace {
 std::atomic<bool> gCancel{false};
 std::atomic<int> gSignal{0};
 std::atomic<bool> gCommitting{false};
+std::atomic<bool> gReported{false};  // the guard is gone after a stop: the interrupt is reported
 static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free);
 
 constexpr std::array<int, 3> kHandledSignals{SIGINT, SIGTERM, SIGHUP};
@@ -26,8 +27,10 @@ extern "C" void onStopSignal(int signal) {
   }
   // A second signal: the user insists. Only write(2) and _exit(2) here (async-signal-safe).
   if (gCommitting.load()) return;
-  static constexpr char kMessage[] = "\nglint: interrupted\n";
-  [[maybe_unused]] const ssize_t written = write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+  if (!gReported.load()) {
+    static constexpr char kMessage[] = "\nglint: interrupted\n";
+    [[maybe_unused]] const ssize_t written = write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+  }
   _exit(SignalGuard::exitCodeFor(expected));
 }
 
@@ -37,6 +40,7 @@ SignalGuard::SignalGuard() {
   gCancel.store(false);
   gSignal.store(0);
   gCommitting.store(false);
+  gReported.store(false);
   struct sigaction action {};
   action.sa_handler = onStopSignal;
   sigemptyset(&action.sa_mask);
@@ -51,6 +55,13 @@ SignalGuard::SignalGuard() {
 }
 
 SignalGuard::~SignalGuard() {
+  // After a stop signal the process is on its way out with 128 + n: a second signal that arrives
+  // now (the user pressing Ctrl-C twice) must still end it with that status, not kill it by the
+  // default action, so the handlers stay.
+  if (gSignal.load() != 0) {
+    gReported.store(true);
+    return;
+  }
   for (std::size_t i = 0; i < kHandledSignals.size(); ++i) {
     sigaction(kHandledSignals[i], &gPrevious[i], nullptr);
   }

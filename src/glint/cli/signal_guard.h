@@ -6,7 +6,8 @@
 
 namespace glint::cli {
 
-// Installs the handlers (sigaction) for its lifetime and restores the previous ones afterwards.
+// Installs the handlers (sigaction) for its lifetime and restores the previous ones afterwards,
+// unless a stop signal came (the handlers then stay until the process exits).
 // SIGHUP (the terminal or the ssh session closed) stops a render like SIGTERM; SIGPIPE is ignored
 // meanwhile, so that a vanished reader of stderr fails the progress writes instead of killing the
 // process before the checkpoint is saved. Only one may exist at a time: the handlers share
