@@ -71,6 +71,8 @@ struct TraceContext {
   // their footprint. Without, neither is ever looked at.
   bool textured;
   bool uniformBackground;  // a miss returns Scene::background() without looking at the direction
+  bool vertexColors;       // some mesh has vertex colours: hits on meshes look them up
+  bool fog;                // the scene has fog: hits and misses go through it
   int samplesPerPixel;     // scales camera ray differentials
 };
 
@@ -395,8 +397,8 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   Hit& hit = depth < ctx.hitCount ? ctx.hits[depth] : deepHit.emplace();
   if (!ctx.scene.intersect(ray, kInfinity, hit)) {
     // Fog measured along rays hides whatever lies at infinity.
-    if (const std::optional<Fog>& fog = ctx.scene.fog(); fog && fog->distance == FogDistance::Ray) {
-      return fog->color;
+    if (ctx.fog && ctx.scene.fog()->distance == FogDistance::Ray) {
+      return ctx.scene.fog()->color;
     }
     return ctx.uniformBackground ? ctx.scene.background()
                                  : ctx.scene.backgroundAlong(ray.direction);
@@ -404,13 +406,14 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   Color color;
   if (ctx.textured) {
     color = traceTexturedHit(ctx, ray, hit, depth, weight, split, stream, differential);
-  } else if (hit.mesh != kNoMesh && !ctx.scene.meshes()[hit.mesh].colors.empty()) {
+  } else if (ctx.vertexColors && hit.mesh != kNoMesh &&
+             !ctx.scene.meshes()[hit.mesh].colors.empty()) {
     color = traceVertexColouredHit(ctx, ray, hit, depth, weight, split, stream);
   } else {
     color = shadeHit(ctx, ray, hit, ctx.scene.materialOf(hit), ctx.scene.emissionOf(hit),
                      hit.shadingNormal, depth, weight, split, stream, nullptr, nullptr);
   }
-  return ctx.scene.fog() ? fogged(ctx, color, ray, hit.t, depth) : color;
+  return ctx.fog ? fogged(ctx, color, ray, hit.t, depth) : color;
 }
 
 // What a ray sees at its hit, seen through the fog over the distance t it travelled (Fog::distance
@@ -439,6 +442,11 @@ std::vector<Hit> hitStorage(const Scene& scene) {
       static_cast<std::size_t>(std::clamp(scene.render().maxDepth, 1, kPreallocatedDepths)));
 }
 
+bool hasVertexColors(const Scene& scene) {
+  return std::any_of(scene.meshes().begin(), scene.meshes().end(),
+                     [](const TriangleMesh& mesh) { return !mesh.colors.empty(); });
+}
+
 TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>& hits) {
   const RenderSettings& settings = scene.render();
   return TraceContext{scene,
@@ -450,6 +458,8 @@ TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>
                       static_cast<int>(hits.size()),
                       scene.hasTextures(),
                       scene.uniformBackground(),
+                      hasVertexColors(scene),
+                      scene.fog().has_value(),
                       samplesPerPixel(scene.image()).minimum};
 }
 
