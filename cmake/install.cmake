@@ -1,5 +1,6 @@
 # Installation and packaging (DESIGN.md §14). `cmake --install build [--prefix P]` puts in place:
 #   bin/glint                                the command            (component runtime)
+#   libexec/glint/glint-mesh-reader          reads mesh files for glint and the library (runtime)
 #   lib/libglint.a, include/glint/           the library, headers   (component dev)
 #   lib/cmake/glint/                         find_package(glint CONFIG) -> glint::glint (dev)
 # `cpack --config build/CPackConfig.cmake` makes two .debs: glint (the command; its Depends from
@@ -8,6 +9,8 @@
 include(CMakePackageConfigHelpers)
 
 install(TARGETS glint_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+install(TARGETS glint_mesh_reader RUNTIME DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/glint
+        COMPONENT runtime)
 install(TARGETS glint EXPORT glintTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
 # Every library header (glint/glint.h includes the public API); not the command's, not tests'.

@@ -14,11 +14,15 @@
 #include <chrono>
 #include <csignal>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <new>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <type_traits>
 #include <utility>
@@ -266,8 +270,64 @@ void setImportChildDelayForTesting(std::chrono::milliseconds delay) {
   gChildDelayMilliseconds.store(delay.count());
 }
 
+namespace {
+
+// What the parent and the mesh reader program must agree on: the answer's layout (Material and
+// the other records cross as raw bytes) is that of one build, so a reader from another glint
+// version is refused.
+constexpr const char* kMeshReaderProtocol = "glint-mesh-reader/" GLINT_VERSION "/1";
+
+// The mesh reader program: GLINT_MESH_READER when set; else the first that exists of
+// glint-mesh-reader beside the running program (the build tree, a program linked with the
+// library), ../libexec/glint/ from it (an installed tree, wherever it was moved), the build tree
+// the library was built in, and the installed libexec folder. Empty when none is found.
+std::filesystem::path findMeshReader() {
+  namespace fs = std::filesystem;
+  if (const char* forced = std::getenv("GLINT_MESH_READER"); forced != nullptr && *forced != 0) {
+    return forced;
+  }
+  std::vector<fs::path> candidates;
+  std::error_code error;
+  const fs::path self = fs::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    candidates.push_back(self.parent_path() / kMeshReaderProgram);
+    candidates.push_back(self.parent_path().parent_path() / "libexec/glint" / kMeshReaderProgram);
+  }
+#ifdef GLINT_MESH_READER_BUILD_PATH
+  candidates.emplace_back(GLINT_MESH_READER_BUILD_PATH);
+#endif
+#ifdef GLINT_MESH_READER_INSTALL_PATH
+  candidates.emplace_back(GLINT_MESH_READER_INSTALL_PATH);
+#endif
+  for (const fs::path& candidate : candidates) {
+    if (fs::is_regular_file(candidate, error) && ::access(candidate.c_str(), X_OK) == 0) {
+      return candidate;
+    }
+  }
+  return {};
+}
+
+// Found once per process.
+const std::filesystem::path& meshReader() {
+  static const std::filesystem::path found = findMeshReader();
+  return found;
+}
+
+// Makes `fd` survive execve (every descriptor glint opens is close-on-exec). Async-signal-safe.
+bool keepAcrossExec(int fd) { return fd < 0 || ::fcntl(fd, F_SETFD, 0) == 0; }
+
+}  // namespace
+
 MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension,
-                           const ReferencedFileRule& rule, const std::atomic<bool>* cancel) {
+                           const std::filesystem::path& sceneFolder,
+                           const std::atomic<bool>* cancel) {
+  const std::filesystem::path& reader = meshReader();
+  if (reader.empty()) {
+    throw MeshLoadError(fmt::format(
+        "cannot start the mesh reader: {} was not found beside this program, in ../libexec/glint "
+        "from it, or where glint was built or installed (set GLINT_MESH_READER to its path)",
+        kMeshReaderProgram));
+  }
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw MeshLoadError(systemReason(errno));
   // The answer travels in a memory file when it can: the child writes it whole without waiting for
@@ -277,7 +337,24 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
   // When there is no memory file (memfd_create refused) or writing it fails (no memory, a file
   // size limit), the child says 'P' and the answer follows on the pipe.
   const int answer = ::memfd_create("glint-mesh-answer", MFD_CLOEXEC);
+  // The child's arguments, made before the fork: between fork and execve the child may only make
+  // async-signal-safe calls (no allocation).
+  const std::vector<std::string> arguments = {reader.string(),
+                                              kMeshReaderProtocol,
+                                              std::to_string(fds[1]),
+                                              std::to_string(answer),
+                                              std::to_string(gChildDelayMilliseconds.load()),
+                                              extension,
+                                              sceneFolder.string(),
+                                              path.string()};
+  std::vector<char*> argv;
+  for (const std::string& a : arguments) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
   const pid_t parent = ::getpid();
+  // fork + execve of a fresh program, not a forked copy that imports: a copy of a multithreaded
+  // glint inherits every lock another thread held at the fork, and waits for it forever if it
+  // needs it (seen with AddressSanitizer's allocator while a test's watchdog thread started, and
+  // with OpenMPI's threads in a rank). The new program inherits no lock.
   const pid_t pid = ::fork();
   if (pid < 0) {
     const int error = errno;
@@ -287,51 +364,23 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
     throw MeshLoadError("cannot start the mesh reader: " + systemReason(error));
   }
   if (pid == 0) {
-    // The child: no destructor, atexit handler or stdio flush of the parent's state runs here.
-    // It dies with glint (killed or interrupted while loading), never left looping on its own.
+    // The child until execve: async-signal-safe calls only. It dies with glint (killed or
+    // interrupted while loading), never left looping on its own; the death signal survives
+    // execve.
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (::getppid() != parent) ::_exit(0);  // the parent was already gone
-    ::close(fds[0]);
-    // Large blocks from the heap rather than each from its own mmap: assimp's OBJ reader and the
-    // post-processing free buffers of megabytes (the file, a line buffer of the file's size, the
-    // meshes PreTransformVertices replaces) that later ones then reuse instead of faulting in
-    // fresh pages (~4 ms of a 100k-triangle OBJ). 32 MiB is the most glibc accepts. The child
-    // ends with _exit, so its heap is never given back in any case.
-    ::mallopt(M_MMAP_THRESHOLD, 32 << 20);
-    ::signal(SIGXFSZ, SIG_IGN);  // a write past a file size limit fails instead
     // Ctrl-C reaches the whole process group, the child too. Its fate is the parent's: a parent
     // that handles the signal cancels the load and kills the child, one that dies of it takes the
-    // child along (PR_SET_PDEATHSIG); the child dying of it on its own would read as a crash.
-    for (const int stop : {SIGINT, SIGTERM, SIGHUP}) ::signal(stop, SIG_IGN);
-    if (const std::int64_t delay = gChildDelayMilliseconds.load(); delay > 0) {
-      const timespec pause{static_cast<time_t>(delay / 1000),
-                           static_cast<long>(delay % 1000) * 1000000};
-      ::nanosleep(&pause, nullptr);
-    }
-    MeshFile result;
-    std::string error;
-    try {
-      result = importMesh(path, extension, rule);
-    } catch (const MeshLoadError& e) {
-      error = e.what();
-    } catch (...) {
-      error = "invalid file: the mesh library failed reading it";
-    }
-    const auto send = [&](int fd) {
-      return error.empty() ? writeMeshFile(fd, result) : writeMessage(fd, 'E', error);
-    };
-    if (answer >= 0 && send(answer)) {
-      writeValue(fds[1], 'D');
-      ::_exit(0);
-    }
-    // A partly written memory file would hold its pages until the parent closes it, after the
-    // whole answer has come through the pipe as well: under the memory pressure that made the
-    // write fail, give them back first.
-    if (answer >= 0) static_cast<void>(::ftruncate(answer, 0));
-    if (writeValue(fds[1], 'P')) {
-      send(fds[1]);
-    }
-    ::_exit(0);
+    // child along (PR_SET_PDEATHSIG); the child dying of it on its own would read as a crash. An
+    // ignored signal stays ignored across execve. A write past a file size limit fails instead
+    // of killing the child.
+    struct sigaction ignore {};
+    ignore.sa_handler = SIG_IGN;
+    for (const int stop : {SIGINT, SIGTERM, SIGHUP, SIGXFSZ}) ::sigaction(stop, &ignore, nullptr);
+    if (keepAcrossExec(fds[1]) && keepAcrossExec(answer)) ::execv(argv[0], argv.data());
+    const int error = errno;
+    static_cast<void>(writeValue(fds[1], 'X') && writeValue(fds[1], error));
+    ::_exit(127);
   }
   ::close(fds[1]);
   std::optional<MeshFile> file;
@@ -340,7 +389,10 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
   Reader in(fds[0], std::chrono::steady_clock::now() + meshReadTimeLimit(path), cancel);
   try {
     const char where = in.value<char>();
-    if (where == 'D' && answer >= 0) {
+    if (where == 'X') {
+      failure = fmt::format("cannot start the mesh reader {}: {}", reader.string(),
+                            systemReason(in.value<int>()));
+    } else if (where == 'D' && answer >= 0) {
       Reader written(answer, cancel);
       file = receiveMeshFile(written);
     } else if (where == 'P') {
@@ -372,6 +424,58 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
   }
   if (!file) throw MeshLoadError(failure);
   return std::move(*file);
+}
+
+int runMeshReader(int argc, char** argv) {
+  // Arguments (importMeshInChild): protocol, answer pipe, answer file (-1: none), delay in ms,
+  // extension, scene folder, mesh file.
+  if (argc != 8) {
+    std::fprintf(stderr, "%s: glint starts this program to read mesh files; it is not run alone\n",
+                 argc > 0 ? argv[0] : kMeshReaderProgram);
+    return 2;
+  }
+  const int pipe = std::atoi(argv[2]);
+  const int answer = std::atoi(argv[3]);
+  if (std::string_view(argv[1]) != kMeshReaderProtocol) {
+    writeMessage(pipe, 'E',
+                 fmt::format("cannot read it: the mesh reader {} is from another glint build ({}, "
+                             "not {})",
+                             argv[0], argv[1], kMeshReaderProtocol));
+    return 2;
+  }
+  // Large blocks from the heap rather than each from its own mmap: assimp's OBJ reader and the
+  // post-processing free buffers of megabytes (the file, a line buffer of the file's size, the
+  // meshes PreTransformVertices replaces) that later ones then reuse instead of faulting in
+  // fresh pages (~4 ms of a 100k-triangle OBJ). 32 MiB is the most glibc accepts. The program
+  // ends with _exit, so its heap is never given back in any case.
+  ::mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  if (const long delay = std::atol(argv[4]); delay > 0) {
+    const timespec pause{static_cast<time_t>(delay / 1000), (delay % 1000) * 1000000};
+    ::nanosleep(&pause, nullptr);
+  }
+  const std::filesystem::path path = argv[7];
+  MeshFile result;
+  std::string error;
+  try {
+    result = importMesh(path, argv[5], ReferencedFileRule(path, argv[6]));
+  } catch (const MeshLoadError& e) {
+    error = e.what();
+  } catch (...) {
+    error = "invalid file: the mesh library failed reading it";
+  }
+  const auto send = [&](int fd) {
+    return error.empty() ? writeMeshFile(fd, result) : writeMessage(fd, 'E', error);
+  };
+  if (answer >= 0 && send(answer)) {
+    writeValue(pipe, 'D');
+    ::_exit(0);
+  }
+  // A partly written memory file would hold its pages until the parent closes it, after the
+  // whole answer has come through the pipe as well: under the memory pressure that made the
+  // write fail, give them back first.
+  if (answer >= 0) static_cast<void>(::ftruncate(answer, 0));
+  if (writeValue(pipe, 'P')) send(pipe);
+  ::_exit(0);
 }
 
 }  // namespace glint

@@ -1,7 +1,7 @@
-// The mesh import in a child process (fork): assimp reads the file there and the MeshFile comes
-// back in a checked binary answer, so that memory corruption inside an importer refuses the file
-// instead of crashing or corrupting the renderer; a time limit stops an importer that loops.
-// Internal to the mesh loader.
+// The mesh import in a child process (the program glint-mesh-reader, started by fork + execve):
+// assimp reads the file there and the MeshFile comes back in a checked binary answer, so that
+// memory corruption inside an importer refuses the file instead of crashing or corrupting the
+// renderer; a time limit stops an importer that loops. Internal to the mesh loader.
 #pragma once
 
 #include <atomic>
@@ -25,8 +25,19 @@ inline constexpr double kMeshReadSecondsPerMiB = 2;
 // inconsistent, or the time limit is a MeshLoadError. While it waits for the child and checks the
 // answer, the parent polls `cancel` (may be null): once it is set the child is killed at once and
 // Cancelled (core/cancel.h) thrown, within ~20 ms.
+// The child reads only what ReferencedFileRule(path, sceneFolder) allows. The program is found
+// as findMeshReader (import_child.cpp) says: GLINT_MESH_READER, beside the running program,
+// ../libexec/glint from it, the build tree, the installed libexec folder.
 MeshFile importMeshInChild(const std::filesystem::path& path, const std::string& extension,
-                           const ReferencedFileRule& rule, const std::atomic<bool>* cancel);
+                           const std::filesystem::path& sceneFolder,
+                           const std::atomic<bool>* cancel);
+
+// The name of the mesh reader program.
+inline constexpr const char* kMeshReaderProgram = "glint-mesh-reader";
+
+// The mesh reader program's main: the child's side of importMeshInChild (its arguments are
+// importMeshInChild's; run alone it says so and returns 2).
+int runMeshReader(int argc, char** argv);
 
 // For tests of the parent's waiting (cancellation, time limit): every child started from now on
 // sleeps `delay` before it reads the file; zero turns it off.

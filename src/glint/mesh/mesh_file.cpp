@@ -28,8 +28,7 @@ MeshFile readMeshFile(const std::filesystem::path& path, const MeshReadOptions& 
   const std::string extension = checkedExtension(path);
   if (extension == ".ply") checkPlyHeader(header, size);
   if (extension == ".gltf" || extension == ".glb") checkGltfPrimitives(path, extension, size);
-  return importMeshInChild(path, extension, ReferencedFileRule(path, options.sceneFolder),
-                           options.cancel);
+  return importMeshInChild(path, extension, options.sceneFolder, options.cancel);
 }
 
 std::vector<TriangleMesh> instantiateMesh(const MeshFile& file,
