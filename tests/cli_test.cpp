@@ -151,6 +151,23 @@ TEST_F(Cli, CheckCountsMeshesAndTheirTriangles) {
   EXPECT_TRUE(filesIn(work_).empty());
 }
 
+// The mesh reader program (glint-mesh-reader) is found beside glint in the build tree; one that
+// cannot be started refuses the mesh at its line, naming the program and why.
+TEST_F(Cli, AMeshReaderThatCannotStartIsAClearErrorAtTheMesh) {
+  const std::string reader = (work_ / "no-such-reader").string();
+  ASSERT_EQ(::setenv("GLINT_MESH_READER", reader.c_str(), 1), 0);
+  const RunResult r =
+      run({"render", (std::filesystem::path(GLINT_SOURCE_DIR) / "scenes" / "mesh.yaml").string(),
+           "-o", "out.png"});
+  ::unsetenv("GLINT_MESH_READER");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "mesh.yaml:")) << r.err;
+  EXPECT_TRUE(
+      contains(r.err, "cannot start the mesh reader " + reader + ": No such file or directory"))
+      << r.err;
+  EXPECT_TRUE(filesIn(work_).empty());
+}
+
 TEST_F(Cli, CheckReportsTheSameErrorsAsRender) {
   const std::string scene = (kBroken / "negative_radius.yaml").string();
   const RunResult check = run({"check", scene});

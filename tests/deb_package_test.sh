@@ -36,6 +36,8 @@ grep -q "glint (= " <<<"$dev_depends" || fail "libglint-dev does not depend on g
 runtime_files="$(dpkg-deb -c "$runtime")"
 dev_files="$(dpkg-deb -c "$dev")"
 grep -q '\./usr/bin/glint$' <<<"$runtime_files" || fail "no /usr/bin/glint in the package"
+grep -q '\./usr/libexec/glint/glint-mesh-reader$' <<<"$runtime_files" ||
+  fail "no /usr/libexec/glint/glint-mesh-reader in the package"
 grep -q 'usr/include/glint/glint.h$' <<<"$dev_files" || fail "no glint.h in libglint-dev"
 grep -q 'cmake/glint/glintConfig.cmake$' <<<"$dev_files" || fail "no CMake package in libglint-dev"
 grep -q 'libglint\.a$' <<<"$dev_files" || fail "no libglint.a in libglint-dev"
@@ -44,4 +46,7 @@ dpkg-deb -x "$runtime" "$work/root"
 "$work/root/usr/bin/glint" --version | grep -q '^glint ' || fail "the unpacked glint does not run"
 "$work/root/usr/bin/glint" render "$source/tests/cli/small.yaml" -o "$work/small.png" --quiet
 [[ -s "$work/small.png" ]] || fail "the unpacked glint did not render"
+# A mesh scene: the unpacked glint reads its mesh with the unpacked reader (../libexec/glint).
+"$work/root/usr/bin/glint" render "$source/scenes/mesh.yaml" -o "$work/mesh.png" --quiet
+[[ -s "$work/mesh.png" ]] || fail "the unpacked glint did not render a mesh scene"
 echo "ok: $(basename "$runtime") and $(basename "$dev")"

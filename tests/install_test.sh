@@ -27,6 +27,13 @@ archive="$(find "$prefix" -name libglint.a)"
 [[ -n "$archive" ]] || fail "no libglint.a"
 ! grep -rlE 'gtest|gmock' "$prefix/include" || fail "test headers were installed"
 [[ ! -e "$prefix/include/glint/cli" ]] || fail "the command's headers were installed"
+[[ -x "$prefix/libexec/glint/glint-mesh-reader" ]] || fail "no libexec/glint/glint-mesh-reader"
+# The installed command reads meshes with the installed reader (../libexec/glint from bin/glint):
+# the same bytes as the build tree's command.
+"$prefix/bin/glint" render "$source/scenes/mesh.yaml" -o "$work/mesh.png" --quiet
+"$build/glint" render "$source/scenes/mesh.yaml" -o "$work/mesh-in-tree.png" --quiet
+cmp "$work/mesh.png" "$work/mesh-in-tree.png" ||
+  fail "the installed glint renders scenes/mesh.yaml other than the build tree's"
 echo "installed: $(cd "$prefix" && find . -type f | wc -l) files (${config#"$prefix"/}, ${archive#"$prefix"/})"
 
 generator=()
