@@ -6,7 +6,8 @@
 //   as YAML; job runs renders and conversions; cluster spreads a job's render over MPI ranks
 //   (above job: it hooks the job's render step, and the job must not know MPI); preview serves a
 //   running job's picture over HTTP (it consumes job events, so it sits above job); cli only turns
-//   arguments into jobs; glint/glint.h, the umbrella header, includes the public API of every
+//   arguments into jobs; mesh_reader (the glint-mesh-reader program) runs mesh's import child;
+//   glint/glint.h, the umbrella header, includes the public API of every
 //   module but cluster (built only with MPI).
 // Tests (*_test.cpp) may use anything.
 #include <gtest/gtest.h>
@@ -44,6 +45,7 @@ const std::map<std::string, std::set<std::string>>& allowedModules() {
       {"preview",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
         "writers", "job", "preview"}},
+      {"mesh_reader", {"core", "geometry", "accel", "scene", "readers", "mesh", "mesh_reader"}},
       {"cli",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
         "writers", "job", "cluster", "preview", "cli"}},
