@@ -163,7 +163,7 @@ TEST_F(Cli, AMeshReaderThatCannotStartIsAClearErrorAtTheMesh) {
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_TRUE(contains(r.err, "mesh.yaml:")) << r.err;
   EXPECT_TRUE(
-      contains(r.err, "cannot start the mesh reader " + reader + ": No such file or directory"))
+      contains(r.err, "cannot start the mesh reader " + reader + ": no such file or directory"))
       << r.err;
   EXPECT_TRUE(filesIn(work_).empty());
 }
