@@ -83,4 +83,14 @@ inline Point2 sampleConcentricDisk(const Point2& u) {
   return {r * std::cos(theta), r * std::sin(theta)};
 }
 
+// Direction about the unit vector `axis` (basis t, b from orthonormalBasis) with density
+// cos θ / π over its hemisphere (Malley's method: a concentric-disk point lifted onto the
+// hemisphere); u in [0,1)².
+inline Vec3 sampleCosineHemisphere(const Vec3& axis, const Vec3& t, const Vec3& b,
+                                   const Point2& u) {
+  const Point2 d = sampleConcentricDisk(u);
+  const double z = std::sqrt(std::max(0.0, 1 - d.x * d.x - d.y * d.y));
+  return t * d.x + b * d.y + axis * z;
+}
+
 }  // namespace glint

@@ -1184,5 +1184,47 @@ TEST(SceneBuilder, FocusDistanceDefaultsToTheLookAtPoint) {
       "camera.look_at must differ from camera.position");
 }
 
+// render.integrator and render.ambient_occlusion (DESIGN.md §10).
+TEST(SceneBuilder, AmbientOcclusionAndIntegratorKeys) {
+  const std::string base = std::string(kMinimal) + "render: ";
+  const auto build = [&](const std::string& render) {
+    return loadSceneFromString(base + render + "\n", "t.yaml").parts.render;
+  };
+  EXPECT_FALSE(build("{max_depth: 3}").ambientOcclusion);
+  const RenderSettings defaults = build("{integrator: whitted, ambient_occlusion: {}}");
+  ASSERT_TRUE(defaults.ambientOcclusion);
+  EXPECT_EQ(defaults.ambientOcclusion->samples, 16);
+  EXPECT_EQ(defaults.ambientOcclusion->distance, std::numeric_limits<double>::infinity());
+  const RenderSettings given = build("{ambient_occlusion: {samples: 64, distance: 2.5}}");
+  ASSERT_TRUE(given.ambientOcclusion);
+  EXPECT_EQ(given.ambientOcclusion->samples, 64);
+  EXPECT_EQ(given.ambientOcclusion->distance, 2.5);
+
+  const auto expectRenderError = [&](const std::string& render, const std::string& token,
+                                     const std::string& fragment) {
+    const std::string line = "render: " + render;
+    expectOneError(std::string(kMinimal) + line + "\n", 3, static_cast<int>(line.find(token)) + 1,
+                   fragment);
+  };
+  expectRenderError("{ambient_occlusion: {samples: 0}}", "0}",
+                    "render.ambient_occlusion.samples must be");
+  expectRenderError("{ambient_occlusion: {distance: -1}}", "-1",
+                    "render.ambient_occlusion.distance must be > 0");
+  expectRenderError("{ambient_occlusion: {sample: 4}}", "sample",
+                    "unknown key 'sample' in render.ambient_occlusion; expected one of: samples, "
+                    "distance (did you mean 'samples'?)");
+  expectRenderError("{ambient_occlusion: 16}", "16",
+                    "render.ambient_occlusion: expected a mapping {samples, distance}, got '16'");
+  expectRenderError("{integrator: wited}", "wited",
+                    "render.integrator must be whitted or path, got 'wited' (did you mean "
+                    "'whitted'?)");
+  expectRenderError("{min_depth: 0}", "0", "render.min_depth must be");
+  const RenderSettings path = build("{integrator: path, min_depth: 5}");
+  EXPECT_EQ(path.integrator, Integrator::Path);
+  EXPECT_EQ(path.minDepth, 5);
+  EXPECT_EQ(build("{}").integrator, Integrator::Whitted);
+  EXPECT_EQ(build("{}").minDepth, 3);
+}
+
 }  // namespace
 }  // namespace glint

@@ -152,7 +152,38 @@ void buildRender(const SceneDescription& scene, const Entity& e, BuildContext& c
   auto params = sectionParameters(scene, e, ctx, "a mapping of render settings", "render");
   if (!params) return;
   ParameterDictionary& p = *params;
-  p.declare({"max_depth", "min_weight", "blur_samples", "seed"});
+  p.declare({"max_depth", "min_weight", "blur_samples", "seed", "integrator", "ambient_occlusion",
+             "min_depth"});
+  // DESIGN.md §10: `whitted` (§3) is the default.
+  if (const auto name = p.text("integrator")) {
+    if (name->value == "whitted") {
+      render.integrator = Integrator::Whitted;
+    } else if (name->value == "path") {
+      render.integrator = Integrator::Path;
+    } else {
+      p.error(
+          name->where,
+          fmt::format("render.integrator must be whitted or path, got {}{}",
+                      quoteForMessage(name->value),
+                      didYouMean(name->value, std::vector<std::string_view>{"whitted", "path"})));
+    }
+  }
+  if (const auto v = readIntegerInRange(p, "min_depth", 1, kMaxRenderDepth)) {
+    render.minDepth = static_cast<int>(*v);
+  }
+  if (auto occlusion = p.mapping("ambient_occlusion", "a mapping {samples, distance}",
+                                 {"in render.ambient_occlusion", "render.ambient_occlusion",
+                                  "render.ambient_occlusion"})) {
+    ParameterDictionary& ao = *occlusion;
+    ao.declare({"samples", "distance"});
+    AmbientOcclusion settings;
+    if (const auto v = readIntegerInRange(ao, "samples", 1, kMaxOcclusionSamples)) {
+      settings.samples = static_cast<int>(*v);
+    }
+    if (const auto v = readPositive(ao, "distance")) settings.distance = *v;
+    ao.finish();
+    render.ambientOcclusion = settings;
+  }
   if (const auto v = readIntegerInRange(p, "max_depth", 1, kMaxRenderDepth)) {
     render.maxDepth = static_cast<int>(*v);
   }

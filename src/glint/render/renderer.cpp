@@ -38,6 +38,7 @@ namespace {
 //   2      reflection lobe: glossy cone direction(s)
 //   3      refraction lobe: the same for the transmitted direction(s)
 //   4 + i  area light i (its index in Scene::lights()): the points sampled on its surface
+//   2^30   ambient occlusion: the directions of its rays (above any light index)
 // The primary hit shares the camera sample's stream (its dimensions start at 2). A secondary ray
 // continues on stream.branch(lobe dimension, count, k): a new key, so the next hit draws its own
 // dimensions 2, 3, 4 + i independently of this hit's; fanned-out sub-samples (glossy rays, area
@@ -48,6 +49,7 @@ constexpr std::uint32_t kLensDimension = 1;
 constexpr std::uint32_t kReflectionDimension = 2;
 constexpr std::uint32_t kRefractionDimension = 3;
 constexpr std::uint32_t kFirstLightDimension = 4;
+constexpr std::uint32_t kOcclusionDimension = std::uint32_t{1} << 30;
 
 // Adaptive anti-aliasing starts with at least this many samples per pixel: fewer give no useful
 // estimate of the pixel's error (four Sobol points already fall one in each quadrant).
@@ -73,7 +75,10 @@ struct TraceContext {
   bool uniformBackground;  // a miss returns Scene::background() without looking at the direction
   bool vertexColors;       // some mesh has vertex colours: hits on meshes look them up
   bool fog;                // the scene has fog: hits and misses go through it
-  int samplesPerPixel;     // scales camera ray differentials
+  const AmbientOcclusion* occlusion;  // render.ambient_occlusion, or null
+  bool path;                          // render.integrator: path (tracePath) rather than Whitted
+  int minDepth;                       // path: Russian roulette from this many hits on
+  int samplesPerPixel;                // scales camera ray differentials
 };
 
 enum class SecondaryKind { Reflection, Refraction };
@@ -169,9 +174,13 @@ struct ShadingPoint {
 // yet takes the light's `samples` points (shadow rays); a path below a glossy split (one of
 // blurSamples sibling rays) takes ⌈samples / blurSamples⌉, so the siblings together spend about
 // `samples` shadow rays per area light at each depth, as the one unsplit path would.
-std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSamples, bool split) {
-  const auto samples = static_cast<std::uint32_t>(std::max(light.samples, 1));
+// Ambient occlusion rays take the same budget.
+std::uint32_t splitSampleCount(int samplesPerHit, std::uint32_t blurSamples, bool split) {
+  const auto samples = static_cast<std::uint32_t>(std::max(samplesPerHit, 1));
   return split ? std::max<std::uint32_t>(1, (samples + blurSamples - 1) / blurSamples) : samples;
+}
+std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSamples, bool split) {
+  return splitSampleCount(light.samples, blurSamples, split);
 }
 
 // An area light's term: the average over its sample points, each a point light of I0 with its own
@@ -188,6 +197,34 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
     const LightSample sample = illuminateFrom(area, x, sp.p);
     if (isBlack(sample.intensity)) continue;
     sum += shadeLightSample(ctx, sp, sample, &x);
+  }
+  return sum / static_cast<double>(count);
+}
+
+// Ambient occlusion (DESIGN.md §10, Tachyon's): the fraction of the ambient light that reaches the
+// hit, as the mean transmittance (the shadow rays' T_L: glass lets it through in part) of rays in
+// cosine-weighted directions about the shading normal on the viewer's side (the side of the
+// geometric surface the ray came from), each travelling render.ambient_occlusion.distance. A
+// direction below the geometric surface (where ns ≠ n) is blocked by the surface itself. The rays
+// count as shadow rays (both are any-hit queries).
+[[gnu::noinline]] Color ambientVisibility(const TraceContext& ctx, SpawnOrigins& origins,
+                                          const Normal3& n, const Normal3& ns, double nv,
+                                          const SampleStream& stream, bool split) {
+  const AmbientOcclusion& occlusion = *ctx.occlusion;
+  const double side = nv < 0 ? 1 : -1;  // +1: the viewer is on n's side
+  const Vec3 axis = toVec(ns) * side;
+  Vec3 tangent;
+  Vec3 bitangent;
+  orthonormalBasis(axis, tangent, bitangent);
+  const std::uint32_t count = splitSampleCount(occlusion.samples, ctx.blurSamples, split);
+  const SobolDimension2D directions = stream.dimension(kOcclusionDimension);
+  Color sum;
+  for (std::uint32_t k = 0; k < count; ++k) {
+    const Vec3 w =
+        sampleCosineHemisphere(axis, tangent, bitangent, directions.at(stream.subIndex(count, k)));
+    if (!(dot(n, w) * side > 0)) continue;
+    ++ctx.counts.shadow;
+    sum += ctx.scene.transmittance(origins.spawn(w), occlusion.distance);
   }
   return sum / static_cast<double>(count);
 }
@@ -280,6 +317,42 @@ Color traceLobe(const TraceContext& ctx, SpawnOrigins& origins, const Normal3& n
   return sum / static_cast<double>(kept);
 }
 
+// The mirror direction of the unit view direction v about the shading normal ns (nsv = ns·v). One
+// that would dive below the geometric surface (n, nv = n·v) is replaced by the geometric mirror
+// direction (it can only happen where ns ≠ n, `smooth`).
+[[gnu::always_inline]] inline Vec3 mirrorDirection(const Vec3& v, const Normal3& n,
+                                                   const Normal3& ns, double nv, double nsv,
+                                                   bool smooth) {
+  Vec3 reflected = v - toVec(ns) * (2 * nsv);
+  if (smooth && !(dot(n, reflected) * nv < 0)) reflected = v - toVec(n) * (2 * nv);
+  return reflected;
+}
+
+// The transmitted direction: straight on with ior 1; otherwise Snell's law with the relative index
+// `eta` (set here; n·v < 0 means the ray enters the surface), and on total internal reflection
+// the mirror direction `reflected` (kt's energy follows the mirror ray).
+[[gnu::always_inline]] inline Vec3 transmittedDirection(double ior, const Vec3& v, const Normal3& n,
+                                                        const Normal3& ns, double nv, bool smooth,
+                                                        const Vec3& reflected, bool entering,
+                                                        double& eta) {
+  Vec3 transmitted = v;
+  if (ior != 1) {
+    eta = entering ? 1 / ior : ior;
+    const Vec3 facing = entering ? toVec(ns) : -toVec(ns);  // normal on the incident side
+    const double cosIncident = -dot(facing, v);
+    const double sin2Transmitted = eta * eta * std::max(0.0, 1 - cosIncident * cosIncident);
+    if (sin2Transmitted >= 1) {
+      transmitted = reflected;
+    } else {
+      const double cosTransmitted = std::sqrt(1 - sin2Transmitted);
+      transmitted = v * eta + facing * (eta * cosIncident - cosTransmitted);
+      // Bent about ns, it must still cross the geometric surface; otherwise go straight on.
+      if (smooth && !(dot(n, transmitted) * nv > 0)) transmitted = v;
+    }
+  }
+  return transmitted;
+}
+
 // True when a branch scaled by `factor` on top of `weight` is still worth tracing.
 bool worthTracing(const Color& factor, const Color& weight, double minWeight, Color& newWeight) {
   if (isBlack(factor)) return false;
@@ -307,17 +380,19 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
   const Normal3& ns = dot(shadingNormal, v) * nv > 0 ? shadingNormal : n;
   const double nsv = dot(ns, v);
 
-  Color color = emission + material.ka * ctx.scene.ambient();
   SpawnOrigins origins(p, pError, n);
+  Color color = emission;
+  if (const Color ambient = material.ka * ctx.scene.ambient(); !isBlack(ambient)) {
+    color += ctx.occlusion == nullptr
+                 ? ambient
+                 : ambient * ambientVisibility(ctx, origins, n, ns, nv, stream, split);
+  }
   color += directLight(ctx, ShadingPoint{material, p, n, ns, v, nv, !isBlack(material.ks), origins},
                        stream, split);
   if (hitDepth >= ctx.maxDepth) return color;
 
-  // A mirror direction about ns that would dive below the geometric surface is replaced by the
-  // geometric mirror direction (it can only happen where ns ≠ n).
   const bool smooth = !(ns == n);
-  Vec3 reflected = v - toVec(ns) * (2 * nsv);
-  if (smooth && !(dot(n, reflected) * nv < 0)) reflected = v - toVec(n) * (2 * nv);
+  const Vec3 reflected = mirrorDirection(v, n, ns, nv, nsv, smooth);
   // Differentials go on only from a hit whose footprint is known.
   const bool carry = textured != nullptr && differential != nullptr && textured->hasDifferentials;
   std::optional<RayDifferential> childDifferential;  // built only when carried
@@ -329,24 +404,10 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
                                      stream, carry ? &*childDifferential : nullptr);
   }
   if (worthTracing(material.kt, weight, ctx.minWeight, branchWeight)) {
-    Vec3 transmitted = v;
-    // Snell's law with the relative index; n·v < 0 means the ray enters the surface.
     const bool entering = nv < 0;
     double eta = 1;
-    if (material.ior != 1) {
-      eta = entering ? 1 / material.ior : material.ior;
-      const Vec3 facing = entering ? toVec(ns) : -toVec(ns);  // normal on the incident side
-      const double cosIncident = -dot(facing, v);
-      const double sin2Transmitted = eta * eta * std::max(0.0, 1 - cosIncident * cosIncident);
-      if (sin2Transmitted >= 1) {
-        transmitted = reflected;  // total internal reflection: kt's energy follows the mirror ray
-      } else {
-        const double cosTransmitted = std::sqrt(1 - sin2Transmitted);
-        transmitted = v * eta + facing * (eta * cosIncident - cosTransmitted);
-        // Bent about ns, it must still cross the geometric surface; otherwise go straight on.
-        if (smooth && !(dot(n, transmitted) * nv > 0)) transmitted = v;
-      }
-    }
+    const Vec3 transmitted =
+        transmittedDirection(material.ior, v, n, ns, nv, smooth, reflected, entering, eta);
     if (carry) {
       childDifferential = transmittedDifferential(p, *textured, *differential, ns, entering, eta);
     }
@@ -424,11 +485,188 @@ Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double
   return fog.apply(color, viewDepth ? t * dot(ray.direction, ctx.scene.camera().toward()) : t);
 }
 
+// ---- render.integrator: path (DESIGN.md §10) ---------------------------------------------------
+//
+// Unidirectional path tracing, one path per camera sample, iterative. At every hit:
+//   - emission counts in full (emissive surfaces are found by the paths that hit them; they are
+//     not sampled as lights), and so does the background a path escapes to;
+//   - the lights of the scene give exactly the Whitted integrator's direct term (directLight:
+//     point, spot and directional lights are delta lights, area lights keep their `samples`
+//     points with Whitted's falloff), so switching integrators never changes direct lighting;
+//   - the ambient light is not added (the background and the surfaces light the scene);
+//   - the path goes on along one lobe chosen with probability proportional to its strength
+//     (largest component of kd, ks, kr, kt): kd by cosine-weighted sampling (f = kd/π, estimator
+//     kd), ks by sampling the normalised modified Phong lobe about the mirror direction
+//     (f = ks·(s+2)/(2π)·cos^s α, pdf (s+1)/(2π)·cos^s α, estimator ks·(s+2)/(s+1)·cos θ), kr and
+//     kt as specular lobes with their blur cones, each divided by the lobe's probability;
+//   - from render.min_depth hits on, Russian roulette ends the path with probability
+//     1 − min(1, max component of its throughput) and divides the survivors by the rest;
+//   - fog, linear in what lies behind it, fades each segment: L += T·(1 − f)·fog; T *= f.
+// Sample dimensions at each hit (the stream of the path there): 2 the lobe direction, 3 the lobe
+// choice (x) and the roulette (y), 4 + i area light i as in Whitted's; the next hit's stream is
+// branch(2, 1, 0). The same bytes on any thread count, crop and MPI split.
+constexpr std::uint32_t kPathDirectionDimension = kReflectionDimension;
+constexpr std::uint32_t kPathChoiceDimension = kRefractionDimension;
+// A blurred specular lobe tries this many cone directions (consecutive points of its dimension)
+// for one on the side of the surface of its ideal direction, as traceLobe keeps only those; after
+// as many misses it takes the ideal direction.
+constexpr std::uint32_t kPathConeTries = 8;
+
+// Direction of a Phong lobe about the unit `axis` with exponent s: cos α = u^(1/(s+1)), density
+// (s+1)/(2π)·cos^s α over the sphere of directions.
+Vec3 samplePhongLobe(const Vec3& axis, double exponent, const Point2& u) {
+  Vec3 tangent;
+  Vec3 bitangent;
+  orthonormalBasis(axis, tangent, bitangent);
+  const double cosAlpha = std::pow(u.x, 1 / (exponent + 1));
+  const double sinAlpha = std::sqrt(std::max(0.0, 1 - cosAlpha * cosAlpha));
+  const double phi = 2 * std::numbers::pi * u.y;
+  return tangent * (std::cos(phi) * sinAlpha) + bitangent * (std::sin(phi) * sinAlpha) +
+         axis * cosAlpha;
+}
+
+// One direction of a specular lobe about `ideal` with blur cone `blurDegrees` (0: `ideal`), on the
+// same side of the geometric surface n as `ideal`.
+Vec3 specularLobeDirection(const Vec3& ideal, double blurDegrees, const Normal3& n,
+                           const SampleStream& stream) {
+  if (!(blurDegrees > 0)) return ideal;
+  const double cosMax = std::cos(std::min(blurDegrees, 180.0) * std::numbers::pi / 180.0);
+  Vec3 tangent;
+  Vec3 bitangent;
+  orthonormalBasis(ideal, tangent, bitangent);
+  const SobolDimension2D directions = stream.dimension(kPathDirectionDimension);
+  const double idealSide = dot(n, ideal);
+  for (std::uint32_t k = 0; k < kPathConeTries; ++k) {
+    const Vec3 w = sampleCone(ideal, tangent, bitangent, cosMax,
+                              directions.at(stream.subIndex(kPathConeTries, k)));
+    if (dot(n, w) * idealSide > 0) return w;
+  }
+  return ideal;
+}
+
+// The radiance along a camera ray (unit direction) by path tracing; see above.
+Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStream& cameraStream,
+                const RayDifferential* differential) {
+  const Scene& scene = ctx.scene;
+  Color radiance;
+  Color throughput(1);
+  Ray ray = cameraRay;
+  SampleStream stream = cameraStream;
+  Hit& hit = ctx.hits[0];  // one hit at a time: nothing refers to the previous one
+  for (int depth = 0;; ++depth) {
+    if (!scene.intersect(ray, kInfinity, hit)) {
+      if (ctx.fog && scene.fog()->distance == FogDistance::Ray) {
+        radiance += throughput * scene.fog()->color;
+      } else {
+        radiance += throughput * (ctx.uniformBackground ? scene.background()
+                                                        : scene.backgroundAlong(ray.direction));
+      }
+      break;
+    }
+    if (ctx.fog) {
+      const Fog& fog = *scene.fog();
+      const bool viewDepth = fog.distance == FogDistance::Depth && depth == 0;
+      const double f =
+          fog.visibility(viewDepth ? hit.t * dot(ray.direction, scene.camera().toward()) : hit.t);
+      radiance += throughput * fog.color * (1 - f);
+      throughput *= f;
+    }
+    // The hit's material, emission and shading normal, textures and vertex colours applied.
+    TexturedHit textured;
+    if (ctx.textured) {
+      shadeTexturedHit(scene, hit, depth == 0 ? differential : nullptr, textured);
+    } else {
+      textured.material = scene.materialOf(hit);
+      textured.emission = scene.emissionOf(hit);
+      textured.shadingNormal = hit.shadingNormal;
+    }
+    Material& material = textured.material;
+    if (ctx.vertexColors && hit.mesh != kNoMesh && !scene.meshes()[hit.mesh].colors.empty()) {
+      const Color tint = scene.aggregate().vertexColor(hit);
+      material.kd *= tint;
+      material.ka *= tint;
+    }
+    radiance += throughput * textured.emission;
+
+    const Point3& p = hit.point;
+    const Normal3& n = hit.normal;
+    const Vec3& v = ray.direction;
+    const double nv = dot(n, v);
+    const Normal3& ns = dot(textured.shadingNormal, v) * nv > 0 ? textured.shadingNormal : n;
+    const double nsv = dot(ns, v);
+    SpawnOrigins origins(p, hit.pointError, n);
+    radiance +=
+        throughput *
+        directLight(ctx, ShadingPoint{material, p, n, ns, v, nv, !isBlack(material.ks), origins},
+                    stream, false);
+    if (depth + 1 >= ctx.maxDepth) break;
+
+    // One lobe, chosen by strength.
+    const double diffuse = maxComponent(material.kd);
+    const double glossy = maxComponent(material.ks);
+    const double mirror = maxComponent(material.kr);
+    const double transmit = maxComponent(material.kt);
+    const double total = diffuse + glossy + mirror + transmit;
+    if (!(total > 0)) break;
+    const Point2 choice = stream.get2D(kPathChoiceDimension);
+    const double pick = choice.x * total;
+    const double side = nv < 0 ? 1 : -1;  // +1: the path arrived on n's side
+    const bool smooth = !(ns == n);
+    const Vec3 reflected = mirrorDirection(v, n, ns, nv, nsv, smooth);
+    Vec3 w;
+    Color factor;
+    if (pick < diffuse + glossy) {
+      const Point2 u = stream.get2D(kPathDirectionDimension);
+      const Vec3 up = toVec(ns) * side;
+      if (pick < diffuse) {
+        Vec3 tangent;
+        Vec3 bitangent;
+        orthonormalBasis(up, tangent, bitangent);
+        w = sampleCosineHemisphere(up, tangent, bitangent, u);
+        factor = material.kd * (total / diffuse);
+      } else {
+        w = samplePhongLobe(reflected, material.shininess, u);
+        const double cosTheta = dot(up, w);
+        if (!(cosTheta > 0)) break;  // below the surface: the BRDF is zero there
+        factor = material.ks * ((material.shininess + 2) / (material.shininess + 1) * cosTheta *
+                                (total / glossy));
+      }
+      if (!(dot(n, w) * side > 0)) break;  // below the geometric surface
+      ++ctx.counts.reflection;
+    } else if (pick < diffuse + glossy + mirror) {
+      w = specularLobeDirection(reflected, material.reflectionBlur, n, stream);
+      factor = material.kr * (total / mirror);
+      ++ctx.counts.reflection;
+    } else {
+      const bool entering = nv < 0;
+      double eta = 1;
+      const Vec3 transmitted =
+          transmittedDirection(material.ior, v, n, ns, nv, smooth, reflected, entering, eta);
+      w = specularLobeDirection(transmitted, material.refractionBlur, n, stream);
+      factor = material.kt * (total / transmit);
+      ++ctx.counts.refraction;
+    }
+    throughput *= factor;
+    if (depth + 1 >= ctx.minDepth) {
+      const double survive = std::min(1.0, maxComponent(throughput));
+      if (!(choice.y < survive)) break;
+      throughput = throughput / survive;
+    }
+    if (isBlack(throughput)) break;
+    ray = origins.spawn(w);
+    stream = stream.branch(kPathDirectionDimension, 1, 0);
+  }
+  return radiance;
+}
+
 // Shading assumes a unit view direction. Camera rays are unit already up to rounding; normalising
 // here anyway keeps render() and traceRay() bit-identical for the same ray.
 Color traceCameraRay(const TraceContext& ctx, const Ray& ray, const SampleStream& stream,
                      const RayDifferential* differential = nullptr) {
   ++ctx.counts.camera;
+  if (ctx.path) {
+    return tracePath(ctx, Ray{ray.origin, normalize(ray.direction)}, stream, differential);
+  }
   return trace(ctx, Ray{ray.origin, normalize(ray.direction)}, 0, Color(1), false, stream,
                differential);
 }
@@ -460,6 +698,9 @@ TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>
                       scene.uniformBackground(),
                       hasVertexColors(scene),
                       scene.fog().has_value(),
+                      settings.ambientOcclusion ? &*settings.ambientOcclusion : nullptr,
+                      settings.integrator == Integrator::Path,
+                      settings.minDepth,
                       samplesPerPixel(scene.image()).minimum};
 }
 
@@ -522,10 +763,14 @@ SamplingPlan samplingPlan(const ImageSettings& image) {
 }
 
 // Whether a render of `scene` under `plan` reads any sampler dimension (see the layout at the top
-// of this file): a jittered pixel offset, a thin lens, an area light or a glossy lobe.
+// of this file): a jittered pixel offset, a thin lens, ambient occlusion, an area light or a glossy
+// lobe.
 // Conservative: a blurred material counts even where its lobe is never traced.
 bool drawsSamples(const Scene& scene, const SamplingPlan& plan) {
-  if (plan.jitter || scene.camera().hasLens()) return true;
+  if (plan.jitter || scene.camera().hasLens() || scene.render().ambientOcclusion ||
+      scene.render().integrator == Integrator::Path) {
+    return true;
+  }
   for (const Light& light : scene.lights()) {
     if (std::holds_alternative<AreaLight>(light)) return true;
   }
@@ -647,6 +892,9 @@ PixelWork estimatePixelWork(const ImageSettings& image, const RenderSettings& re
     glossy = glossy || material.reflectionBlur > 0 || material.refractionBlur > 0;
     strongest = std::max({strongest, maxComponent(material.kr), maxComponent(material.kt)});
   }
+  if (render.ambientOcclusion) {
+    work.shadowRaysPerHit += static_cast<std::uint64_t>(render.ambientOcclusion->samples);
+  }
   work.glossyRaysPerHit = glossy ? static_cast<std::uint64_t>(std::max(render.blurSamples, 1)) : 0;
   int depth = secondary ? std::max(render.maxDepth, 1) : 1;
   // A branch stops once its weight, at most strongest^k after k bounces, is below min_weight.
@@ -657,6 +905,12 @@ PixelWork estimatePixelWork(const ImageSettings& image, const RenderSettings& re
   work.depth = depth;
   // A forking path visits up to 2^depth − 1 hits (capped far above any warning threshold).
   work.hitsPerSample = branching ? std::exp2(std::min(depth, 200)) - 1 : depth;
+  if (render.integrator == Integrator::Path) {
+    // One path of up to max_depth hits, one ray on from each.
+    work.depth = std::max(render.maxDepth, 1);
+    work.hitsPerSample = work.depth;
+    work.glossyRaysPerHit = 1;
+  }
   return work;
 }
 

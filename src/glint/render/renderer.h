@@ -92,7 +92,8 @@ struct PixelWork {
   int depth = 1;                       // surface hits along one path (max_depth, cut by min_weight)
   double hitsPerSample = 1;            // depth, or 2^depth − 1 when some material both reflects
                                        // and transmits (every such hit forks the path)
-  std::uint64_t shadowRaysPerHit = 0;  // one per light, `samples` per area light
+  std::uint64_t shadowRaysPerHit = 0;  // one per light, `samples` per area light, and the
+                                       // ambient occlusion rays
   std::uint64_t glossyRaysPerHit = 0;  // blur_samples when some material is glossy, else 0
   double raysPerPixel() const {
     return static_cast<double>(samples) * hitsPerSample *

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "glint/geometry/shape.h"
+#include "glint/render/render_test_support.h"
 #include "glint/scene/scene.h"
 
 namespace glint {
@@ -157,20 +158,7 @@ TEST(Renderer, TileSizeAndThreadCountDoNotChangeThePixels) {
   parts.primitives.emplace_back(Sphere::make({0, 0, -6}, 2), addMaterial(parts, glossy), Color{});
   parts.image.samples = 2;
   parts.render.blurSamples = 3;
-  const Scene scene(std::move(parts));
-  RenderOptions reference;
-  reference.threads = 1;
-  reference.tileSize = 16;
-  const Film expected = render(scene, reference);
-  for (const int tileSize : {1, 5, 64}) {
-    for (const int threads : {1, 2}) {
-      RenderOptions options;
-      options.threads = threads;
-      options.tileSize = tileSize;
-      EXPECT_TRUE(sameFilm(render(scene, options), expected))
-          << "tile " << tileSize << ", threads " << threads;
-    }
-  }
+  EXPECT_TRUE(testing::rendersTheSameOnAnyThreadCountAndTileSize(Scene(std::move(parts))));
 }
 
 // A subset of tiles, or tiles from a feed, into the caller's film: the rendered tiles have the

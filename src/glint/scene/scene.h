@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,11 +46,27 @@ struct ImageSettings {
   std::optional<AdaptiveSampling> adaptive;
 };
 
+// Ambient occlusion for the Whitted integrator (render.ambient_occlusion, DESIGN.md §10, as
+// Tachyon has it): at every hit the ambient term ka·Ia is scaled by the transmittance, averaged
+// over `samples` cosine-weighted directions about the shading normal on the viewer's side, of
+// shadow-style rays that travel `distance` (scene units; infinite by default).
+struct AmbientOcclusion {
+  int samples = 16;  // rays per hit (fewer below a glossy split, as area-light samples)
+  double distance = std::numeric_limits<double>::infinity();  // > 0
+};
+
+// render.integrator (DESIGN.md §10): Whitted's model (§3, the default) or unidirectional path
+// tracing with the normalised Phong BRDF.
+enum class Integrator { Whitted, Path };
+
 struct RenderSettings {
+  Integrator integrator = Integrator::Whitted;
+  int minDepth = 3;          // path: Russian roulette from this many surface hits on
   int maxDepth = 10;         // surface hits per path, the primary hit included
   double minWeight = 0.001;  // a branch stops when the product of kr/kt factors falls below this
   int blurSamples = 16;      // rays per glossy reflection/refraction
   std::uint64_t seed = 0;    // varies every random number, deterministically
+  std::optional<AmbientOcclusion> ambientOcclusion;  // none by default
 };
 
 // Everything needed to build a Scene. The scene builder fills this from a scene file; programs may

@@ -12,9 +12,10 @@
 
 namespace glint {
 
-inline constexpr std::int64_t kMaxImageSide = 65535;        // pixels, width and height
-inline constexpr std::int64_t kMaxSamplesPerPixel = 65536;  // image.samples
-inline constexpr std::int64_t kMaxBlurSamples = 65536;      // render.blur_samples
+inline constexpr std::int64_t kMaxImageSide = 65535;         // pixels, width and height
+inline constexpr std::int64_t kMaxSamplesPerPixel = 65536;   // image.samples
+inline constexpr std::int64_t kMaxBlurSamples = 65536;       // render.blur_samples
+inline constexpr std::int64_t kMaxOcclusionSamples = 65536;  // render.ambient_occlusion.samples
 // render.max_depth: the renderer recurses once per surface hit, so an unbounded depth between two
 // perfect mirrors (weight never falls below min_weight) would overflow a worker thread's stack.
 inline constexpr std::int64_t kMaxRenderDepth = 1000;

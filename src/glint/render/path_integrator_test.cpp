@@ -1,0 +1,167 @@
+// render.integrator: path (DESIGN.md §10): the white furnace, the same direct light as the Whitted
+// integrator, Russian roulette without bias, and the same bytes on any thread count.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstddef>
+#include <utility>
+#include <vector>
+
+#include "glint/geometry/shape.h"
+#include "glint/render/render_test_support.h"
+#include "glint/render/renderer.h"
+#include "glint/scene/scene.h"
+
+namespace glint {
+namespace {
+
+// The camera at the origin looking down −z through a 2×2 view plane at distance 1.
+SceneParts cameraParts(int width, int height) {
+  SceneParts parts;
+  parts.camera.position = {0, 0, 0};
+  parts.camera.direction = {0, 0, -1};
+  parts.camera.up = {0, 1, 0};
+  parts.camera.viewPlaneWidth = 2.0 * width / height;
+  parts.camera.viewPlaneHeight = 2;
+  parts.camera.viewPlaneDistance = 1;
+  parts.image.width = width;
+  parts.image.height = height;
+  parts.image.encoding = Encoding::Linear;
+  parts.render.integrator = Integrator::Path;
+  return parts;
+}
+
+std::uint32_t addMaterial(SceneParts& parts, const Material& material) {
+  parts.materials.push_back(material);
+  return static_cast<std::uint32_t>(parts.materials.size() - 1);
+}
+
+Material diffuse(const Color& kd) {
+  Material m;
+  m.kd = kd;
+  return m;  // ka stays 1: the path integrator must not add the ambient light
+}
+
+Color meanOf(const Film& film) {
+  Color sum;
+  for (const Color& c : film.pixels()) sum += c;
+  return sum / static_cast<double>(film.pixels().size());
+}
+
+// White furnace: a diffuse convex object with kd = a under a uniform background L renders a·L;
+// every path that leaves it escapes, so each sample is exactly a·L.
+TEST(PathIntegrator, WhiteFurnaceSphereAndPlane) {
+  const Color background(0.5, 0.7, 0.9);
+  const Color albedo(0.8, 0.5, 0.25);
+  for (const bool sphere : {true, false}) {
+    SceneParts parts = cameraParts(16, 16);
+    parts.background = background;
+    parts.ambient = Color(1, 1, 1);  // not added under `path`
+    parts.image.samples = 16;
+    const std::uint32_t m = addMaterial(parts, diffuse(albedo));
+    if (sphere) {
+      parts.primitives.emplace_back(Sphere::make({0, 0, -5}, 10), m, Color{});
+      parts.camera.position = {0, 0, 30};  // outside it, the sphere filling the view
+      parts.camera.viewPlaneWidth = parts.camera.viewPlaneHeight = 0.2;
+    } else {
+      // A plane seen from above filling the view.
+      parts.primitives.emplace_back(Plane::make({0, 0, -5}, {0, 0, 1}), m, Color{});
+    }
+    const Film film = render(Scene(std::move(parts)));
+    for (const Color& c : film.pixels()) {
+      EXPECT_NEAR(c.r, albedo.r * background.r, 1e-12) << (sphere ? "sphere" : "plane");
+      EXPECT_NEAR(c.g, albedo.g * background.g, 1e-12);
+      EXPECT_NEAR(c.b, albedo.b * background.b, 1e-12);
+    }
+  }
+}
+
+// A single diffuse plane under one light of each kind: the path integrator's direct light is the
+// Whitted integrator's (no ambient, a black background: nothing else reaches the plane), to the
+// bit — the area light's points come from the same sampler dimensions.
+TEST(PathIntegrator, DirectLightIsTheWhittedIntegratorsForEveryLightKind) {
+  std::vector<Light> lights;
+  lights.push_back(PointLight{{1, 2, -3}, Color(3, 2, 1), {1, 0, 0.1}});
+  lights.push_back(DirectionalLight{normalize(Vec3{0.3, -0.5, -1}), Color(0.9, 0.8, 0.7)});
+  SpotLight spot;
+  spot.position = {0, 3, -4};
+  spot.direction = normalize(Vec3{0, -1, -0.5});
+  spot.intensity = Color(2, 2, 2);
+  spot.exponent = 4;
+  lights.push_back(spot);
+  AreaLight area;
+  area.shape = AreaShape::Rectangle;
+  area.corner = {-1, 2, -6};
+  area.edge1 = {2, 0, 0};
+  area.edge2 = {0, 0, 2};
+  area.intensity = Color(1.5, 1.5, 1.5);
+  area.samples = 8;
+  lights.push_back(area);
+  for (std::size_t i = 0; i < lights.size(); ++i) {
+    const auto scene = [&](Integrator integrator) {
+      SceneParts parts = cameraParts(12, 9);
+      parts.image.samples = 4;
+      parts.render.integrator = integrator;
+      Material matte = diffuse(Color(0.7, 0.6, 0.5));
+      parts.primitives.emplace_back(Plane::make({0, -1, 0}, {0, 1, 0}), addMaterial(parts, matte),
+                                    Color{});
+      parts.lights.push_back(lights[i]);
+      return Scene(std::move(parts));
+    };
+    const Film whitted = render(scene(Integrator::Whitted));
+    const Film path = render(scene(Integrator::Path));
+    ASSERT_EQ(whitted.pixels().size(), path.pixels().size());
+    double lit = 0;
+    for (std::size_t k = 0; k < whitted.pixels().size(); ++k) {
+      EXPECT_EQ(whitted.pixels()[k], path.pixels()[k]) << "light " << i << " pixel " << k;
+      lit += whitted.pixels()[k].r;
+    }
+    EXPECT_GT(lit, 0) << "light " << i << " lights nothing";
+  }
+}
+
+// Inside a closed sphere whose inner surface emits E and reflects diffusely with albedo a, the
+// radiance is E·(1 + a + a² + …) = E/(1 − a). Russian roulette (from the third hit) and the
+// 1000-hit cap must not bias it: the mean of 16×16 pixels × 64 samples is within 1 %.
+TEST(PathIntegrator, ClosedEmissiveSphereConvergesToTheGeometricSeries) {
+  SceneParts parts = cameraParts(16, 16);
+  parts.image.samples = 64;
+  parts.render.maxDepth = 1000;
+  const double albedo = 0.5;
+  const Color emission(0.25, 0.5, 1);
+  parts.primitives.emplace_back(Sphere::make({0, 0, 0}, 10),
+                                addMaterial(parts, diffuse(Color(albedo))), emission);
+  RenderStats stats;
+  const Film film = render(Scene(std::move(parts)), {}, &stats);
+  const Color mean = meanOf(film);
+  EXPECT_NEAR(mean.r / (emission.r / (1 - albedo)), 1, 0.01);
+  EXPECT_NEAR(mean.g / (emission.g / (1 - albedo)), 1, 0.01);
+  EXPECT_NEAR(mean.b / (emission.b / (1 - albedo)), 1, 0.01);
+  // Paths went on after the primary hit: indirect rays were traced and counted.
+  EXPECT_GT(stats.rays.reflection, stats.rays.camera);
+}
+
+TEST(PathIntegrator, TheSameBytesOnAnyThreadCountAndTileSize) {
+  SceneParts parts = cameraParts(20, 14);
+  parts.image.samples = 3;
+  parts.background = Color(0.3, 0.4, 0.5);
+  Material shiny = diffuse(Color(0.4, 0.5, 0.6));
+  shiny.ks = Color(0.3);
+  shiny.shininess = 20;
+  shiny.kr = Color(0.1);
+  shiny.reflectionBlur = 10;
+  Material glass;
+  glass.kd = Color(0);
+  glass.kt = Color(0.9);
+  glass.ior = 1.5;
+  parts.primitives.emplace_back(Plane::make({0, -1, 0}, {0, 1, 0}), addMaterial(parts, shiny),
+                                Color{});
+  parts.primitives.emplace_back(Sphere::make({0.5, 0, -4}, 1), addMaterial(parts, glass), Color{});
+  parts.primitives.emplace_back(Sphere::make({-1.5, 0, -5}, 1), addMaterial(parts, shiny),
+                                Color(0.5, 0.2, 0.1));
+  parts.lights.push_back(PointLight{{0, 4, -2}, Color(5, 5, 5), {0, 0, 1}});
+  EXPECT_TRUE(testing::rendersTheSameOnAnyThreadCountAndTileSize(Scene(std::move(parts))));
+}
+
+}  // namespace
+}  // namespace glint
