@@ -4,12 +4,16 @@
 
 #include <cmath>
 #include <cstddef>
+#include <memory>
+#include <numbers>
 #include <utility>
 #include <vector>
 
 #include "glint/geometry/shape.h"
 #include "glint/render/render_test_support.h"
 #include "glint/render/renderer.h"
+#include "glint/scene/environment.h"
+#include "glint/scene/mip_map.h"
 #include "glint/scene/scene.h"
 
 namespace glint {
@@ -161,6 +165,113 @@ TEST(PathIntegrator, TheSameBytesOnAnyThreadCountAndTileSize) {
                                 Color(0.5, 0.2, 0.1));
   parts.lights.push_back(PointLight{{0, 4, -2}, Color(5, 5, 5), {0, 0, 1}});
   EXPECT_TRUE(testing::rendersTheSameOnAnyThreadCountAndTileSize(Scene(std::move(parts))));
+}
+
+// An equirectangular environment of width × height texels of `sky`, with a square patch of
+// `sunSize` texels of `sun` around texel (sunX, sunY) (rows from the top).
+Environment skyWithSun(int width, int height, float sky, float sun, int sunX, int sunY, int sunSize,
+                       double rotateDegrees = 0) {
+  RgbImage image{width, height,
+                 std::vector<float>(static_cast<std::size_t>(width * height * 3), sky)};
+  for (int y = sunY; y < sunY + sunSize; ++y) {
+    for (int x = sunX; x < sunX + sunSize; ++x) {
+      for (int c = 0; c < 3; ++c)
+        image.pixels[static_cast<std::size_t>(3 * (y * width + x) + c)] = sun;
+    }
+  }
+  Environment e;
+  e.kind = BackgroundKind::Image;
+  e.image = std::make_shared<const MipMap>(std::move(image));
+  e.cosRotate = std::cos(rotateDegrees * std::numbers::pi / 180);
+  e.sinRotate = std::sin(rotateDegrees * std::numbers::pi / 180);
+  return e;
+}
+
+// The environment sampler's density integrates to 1 over the sphere, and the density sample()
+// returns is the one pdf() gives for the same direction.
+TEST(EnvironmentSampler, ADensityOverTheSphereThatSampleAndPdfAgreeOn) {
+  const Environment sky = skyWithSun(64, 32, 0.2f, 400, 40, 6, 3, 30);
+  const auto sampler = EnvironmentSampler::make(sky);
+  ASSERT_NE(sampler, nullptr);
+  // Midpoint quadrature over θ, φ: ∫ pdf dω.
+  constexpr int kSteps = 1024;
+  double integral = 0;
+  for (int i = 0; i < kSteps; ++i) {
+    const double theta = (i + 0.5) * std::numbers::pi / kSteps;
+    for (int j = 0; j < 2 * kSteps; ++j) {
+      const double phi = (j + 0.5) * std::numbers::pi / kSteps;
+      const Vec3 d{std::sin(theta) * std::cos(phi), std::cos(theta),
+                   std::sin(theta) * std::sin(phi)};
+      integral += sampler->pdf(d) * std::sin(theta);
+    }
+  }
+  integral *= (std::numbers::pi / kSteps) * (std::numbers::pi / kSteps);
+  EXPECT_NEAR(integral, 1, 0.01);
+  // Drawn directions are unit, carry pdf()'s density, and fall mostly on the sun: it holds
+  // 9 × 400 of the 2048 × 0.2 + 9 × 400 luminance (before the sin θ weights).
+  int onSun = 0;
+  constexpr int kDraws = 4096;
+  for (int k = 0; k < kDraws; ++k) {
+    const Point2 u{(k + 0.5) / kDraws, std::fmod(k * 0.6180339887498949, 1.0)};
+    double pdf = 0;
+    const Vec3 d = sampler->sample(u, pdf);
+    ASSERT_NEAR(length(d), 1, 1e-12);
+    ASSERT_GT(pdf, 0);
+    EXPECT_NEAR(sampler->pdf(d) / pdf, 1, 1e-6) << k;
+    if (sky.along(d, Color()).r > 100) ++onSun;
+  }
+  EXPECT_GT(onSun, kDraws * 8 / 10);
+  // A black image is nothing to sample.
+  EXPECT_EQ(EnvironmentSampler::make(skyWithSun(8, 4, 0, 0, 0, 0, 0)), nullptr);
+}
+
+// A diffuse plane facing up under a sky with a small bright sun: its radiance is
+// kd/π · ∫ L(ω) cos θ dω over the upper hemisphere (computed here by quadrature of the
+// background); the environment's samples find the sun, the BRDF's cover the rest, and the mean
+// of an 8×8 image at 1024 samples lands within 1 % (0.9925 here; 0.9991 at 8192 samples: the
+// estimate converges on the integral).
+TEST(PathIntegrator, AnImageSkyLightsADiffusePlaneAsItsIntegralSays) {
+  const Environment sky = skyWithSun(64, 32, 0.2f, 400, 20, 5, 2, 70);
+  constexpr double kd = 0.6;
+  constexpr int kSteps = 1024;
+  double irradiance = 0;
+  for (int i = 0; i < kSteps; ++i) {
+    const double theta = (i + 0.5) * (std::numbers::pi / 2) / kSteps;
+    for (int j = 0; j < 4 * kSteps; ++j) {
+      const double phi = (j + 0.5) * (std::numbers::pi / 2) / kSteps;
+      const Vec3 d{std::sin(theta) * std::cos(phi), std::cos(theta),
+                   std::sin(theta) * std::sin(phi)};
+      irradiance += sky.along(d, Color()).r * std::cos(theta) * std::sin(theta);
+    }
+  }
+  irradiance *= std::pow((std::numbers::pi / 2) / kSteps, 2);
+  SceneParts parts = cameraParts(8, 8);
+  parts.camera.position = {0, 5, 0};
+  parts.camera.direction = {0, -1, 0};
+  parts.camera.up = {0, 0, -1};
+  parts.image.samples = 1024;
+  parts.environment = sky;
+  parts.primitives.emplace_back(Plane::make({0, 0, 0}, {0, 1, 0}),
+                                addMaterial(parts, diffuse(Color(kd))), Color{});
+  const Scene scene(std::move(parts));
+  ASSERT_NE(scene.environmentSampler(), nullptr);
+  const Color mean = meanOf(render(scene));
+  EXPECT_NEAR(mean.r / (kd / std::numbers::pi * irradiance), 1, 0.01);
+}
+
+// The furnace under an image sky of one colour: multiple importance sampling between the
+// environment's samples and the BRDF's still gives a·L (mean within 0.5 %).
+TEST(PathIntegrator, WhiteFurnaceUnderAnImageSky) {
+  SceneParts parts = cameraParts(16, 16);
+  parts.image.samples = 64;
+  parts.environment = skyWithSun(32, 16, 0.75f, 0.75f, 0, 0, 0);
+  const double albedo = 0.8;
+  parts.primitives.emplace_back(Sphere::make({0, 0, -5}, 10),
+                                addMaterial(parts, diffuse(Color(albedo))), Color{});
+  parts.camera.position = {0, 0, 30};
+  parts.camera.viewPlaneWidth = parts.camera.viewPlaneHeight = 0.2;
+  const Color mean = meanOf(render(Scene(std::move(parts))));
+  EXPECT_NEAR(mean.r / (albedo * 0.75), 1, 0.005);
 }
 
 }  // namespace

@@ -39,6 +39,7 @@ namespace {
 //   3      refraction lobe: the same for the transmitted direction(s)
 //   4 + i  area light i (its index in Scene::lights()): the points sampled on its surface
 //   2^30   ambient occlusion: the directions of its rays (above any light index)
+//   2^30+1 path: the direction toward the image environment (next-event estimation)
 // The primary hit shares the camera sample's stream (its dimensions start at 2). A secondary ray
 // continues on stream.branch(lobe dimension, count, k): a new key, so the next hit draws its own
 // dimensions 2, 3, 4 + i independently of this hit's; fanned-out sub-samples (glossy rays, area
@@ -50,6 +51,7 @@ constexpr std::uint32_t kReflectionDimension = 2;
 constexpr std::uint32_t kRefractionDimension = 3;
 constexpr std::uint32_t kFirstLightDimension = 4;
 constexpr std::uint32_t kOcclusionDimension = std::uint32_t{1} << 30;
+constexpr std::uint32_t kEnvironmentDimension = kOcclusionDimension + 1;
 
 // Adaptive anti-aliasing starts with at least this many samples per pixel: fewer give no useful
 // estimate of the pixel's error (four Sobol points already fall one in each quadrant).
@@ -75,10 +77,11 @@ struct TraceContext {
   bool uniformBackground;  // a miss returns Scene::background() without looking at the direction
   bool vertexColors;       // some mesh has vertex colours: hits on meshes look them up
   bool fog;                // the scene has fog: hits and misses go through it
-  const AmbientOcclusion* occlusion;  // render.ambient_occlusion, or null
-  bool path;                          // render.integrator: path (tracePath) rather than Whitted
-  int minDepth;                       // path: Russian roulette from this many hits on
-  int samplesPerPixel;                // scales camera ray differentials
+  const AmbientOcclusion* occlusion;      // render.ambient_occlusion, or null
+  bool path;                              // render.integrator: path (tracePath) rather than Whitted
+  const EnvironmentSampler* environment;  // path: the image background's sampler, or null
+  int minDepth;                           // path: Russian roulette from this many hits on
+  int samplesPerPixel;                    // scales camera ray differentials
 };
 
 enum class SecondaryKind { Reflection, Refraction };
@@ -489,7 +492,10 @@ Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double
 //
 // Unidirectional path tracing, one path per camera sample, iterative. At every hit:
 //   - emission counts in full (emissive surfaces are found by the paths that hit them; they are
-//     not sampled as lights), and so does the background a path escapes to;
+//     not sampled as lights), and so does a uniform or gradient background a path escapes to;
+//   - an image background is also sampled as a light (EnvironmentSampler: by luminance): one
+//     shadow ray per hit with diffuse or glossy lobes, blocked by any surface, weighted against
+//     the BRDF samples that escape to it by the power heuristic (multiple importance sampling);
 //   - the lights of the scene give exactly the Whitted integrator's direct term (directLight:
 //     point, spot and directional lights are delta lights, area lights keep their `samples`
 //     points with Whitted's falloff), so switching integrators never changes direct lighting;
@@ -503,8 +509,9 @@ Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double
 //     1 − min(1, max component of its throughput) and divides the survivors by the rest;
 //   - fog, linear in what lies behind it, fades each segment: L += T·(1 − f)·fog; T *= f.
 // Sample dimensions at each hit (the stream of the path there): 2 the lobe direction, 3 the lobe
-// choice (x) and the roulette (y), 4 + i area light i as in Whitted's; the next hit's stream is
-// branch(2, 1, 0). The same bytes on any thread count, crop and MPI split.
+// choice (x) and the roulette (y), 4 + i area light i as in Whitted's, 2^30 + 1 the environment
+// direction; the next hit's stream is branch(2, 1, 0). The same bytes on any thread count, crop and
+// MPI split.
 constexpr std::uint32_t kPathDirectionDimension = kReflectionDimension;
 constexpr std::uint32_t kPathChoiceDimension = kRefractionDimension;
 // A blurred specular lobe tries this many cone directions (consecutive points of its dimension)
@@ -544,6 +551,59 @@ Vec3 specularLobeDirection(const Vec3& ideal, double blurDegrees, const Normal3&
   return ideal;
 }
 
+// The power heuristic (Veach, β = 2): the weight of a sample drawn with density `own` when another
+// strategy would have drawn it with density `other`.
+double powerHeuristic(double own, double other) {
+  const double a = own * own;
+  return a / (a + other * other);
+}
+
+// The diffuse and glossy part of the normalised Phong BRDF at one hit, and the density with which
+// the path's lobe choice draws a direction from those two lobes.
+struct PhongLobes {
+  const Material& material;
+  const Vec3& up;         // shading normal on the side the path arrived from
+  const Vec3& reflected;  // mirror direction of the view ray
+  double diffuseShare;    // probability of the diffuse lobe (its strength / all lobes')
+  double glossyShare;     // probability of the Phong lobe
+
+  // f(wi)·cos θ and the density; zero below the shading surface.
+  Color weighted(const Vec3& wi, double& pdf) const {
+    pdf = 0;
+    const double cosTheta = dot(up, wi);
+    if (!(cosTheta > 0)) return Color();
+    Color f;
+    if (diffuseShare > 0) {
+      f += material.kd * std::numbers::inv_pi;
+      pdf += diffuseShare * cosTheta * std::numbers::inv_pi;
+    }
+    if (glossyShare > 0) {
+      const double lobe = std::pow(std::max(0.0, dot(reflected, wi)), material.shininess);
+      f += material.ks * ((material.shininess + 2) * lobe / (2 * std::numbers::pi));
+      pdf += glossyShare * (material.shininess + 1) * lobe / (2 * std::numbers::pi);
+    }
+    return f * cosTheta;
+  }
+};
+
+// Next-event estimation toward the image environment: one direction drawn by luminance, its
+// radiance if no surface is in the way, weighted against the BRDF's samples by the power
+// heuristic. `side` is +1 when the path arrived on n's side.
+Color environmentLight(const TraceContext& ctx, const PhongLobes& lobes, const Normal3& n,
+                       double side, SpawnOrigins& origins, const SampleStream& stream) {
+  double lightPdf = 0;
+  const Vec3 wi = ctx.environment->sample(stream.get2D(kEnvironmentDimension), lightPdf);
+  if (!(lightPdf > 0) || !(dot(n, wi) * side > 0)) return Color();
+  double brdfPdf = 0;
+  const Color f = lobes.weighted(wi, brdfPdf);
+  if (isBlack(f)) return Color();
+  ++ctx.counts.shadow;
+  // Any surface blocks it: light through glass reaches the hit along the glass's own lobes.
+  Hit blocker;
+  if (ctx.scene.intersect(origins.spawn(wi), kInfinity, blocker)) return Color();
+  return f * ctx.scene.backgroundAlong(wi) * (powerHeuristic(lightPdf, brdfPdf) / lightPdf);
+}
+
 // The radiance along a camera ray (unit direction) by path tracing; see above.
 Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStream& cameraStream,
                 const RayDifferential* differential) {
@@ -553,13 +613,21 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
   Ray ray = cameraRay;
   SampleStream stream = cameraStream;
   Hit& hit = ctx.hits[0];  // one hit at a time: nothing refers to the previous one
+  // The density with which the diffuse and glossy lobes drew `ray` (PhongLobes), for multiple
+  // importance sampling where it meets the image environment; 0 for camera rays and specular
+  // lobes, which the environment's samples never stand in for.
+  double brdfPdf = 0;
   for (int depth = 0;; ++depth) {
     if (!scene.intersect(ray, kInfinity, hit)) {
       if (ctx.fog && scene.fog()->distance == FogDistance::Ray) {
         radiance += throughput * scene.fog()->color;
+      } else if (ctx.uniformBackground) {
+        radiance += throughput * scene.background();
       } else {
-        radiance += throughput * (ctx.uniformBackground ? scene.background()
-                                                        : scene.backgroundAlong(ray.direction));
+        const double misWeight = brdfPdf > 0 && ctx.environment != nullptr
+                                     ? powerHeuristic(brdfPdf, ctx.environment->pdf(ray.direction))
+                                     : 1;
+        radiance += throughput * scene.backgroundAlong(ray.direction) * misWeight;
       }
       break;
     }
@@ -613,11 +681,16 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
     const double side = nv < 0 ? 1 : -1;  // +1: the path arrived on n's side
     const bool smooth = !(ns == n);
     const Vec3 reflected = mirrorDirection(v, n, ns, nv, nsv, smooth);
+    const Vec3 up = toVec(ns) * side;
+    const PhongLobes lobes{material, up, reflected, diffuse / total, glossy / total};
+    if (ctx.environment != nullptr && diffuse + glossy > 0) {
+      radiance += throughput * environmentLight(ctx, lobes, n, side, origins, stream);
+    }
     Vec3 w;
     Color factor;
+    brdfPdf = 0;
     if (pick < diffuse + glossy) {
       const Point2 u = stream.get2D(kPathDirectionDimension);
-      const Vec3 up = toVec(ns) * side;
       if (pick < diffuse) {
         Vec3 tangent;
         Vec3 bitangent;
@@ -632,6 +705,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
                                 (total / glossy));
       }
       if (!(dot(n, w) * side > 0)) break;  // below the geometric surface
+      if (ctx.environment != nullptr) lobes.weighted(w, brdfPdf);
       ++ctx.counts.reflection;
     } else if (pick < diffuse + glossy + mirror) {
       w = specularLobeDirection(reflected, material.reflectionBlur, n, stream);
@@ -700,6 +774,7 @@ TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>
                       scene.fog().has_value(),
                       settings.ambientOcclusion ? &*settings.ambientOcclusion : nullptr,
                       settings.integrator == Integrator::Path,
+                      scene.environmentSampler(),
                       settings.minDepth,
                       samplesPerPixel(scene.image()).minimum};
 }

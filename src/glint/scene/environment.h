@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "glint/core/color.h"
 #include "glint/core/vec.h"
@@ -33,6 +34,40 @@ struct Environment {
 
   // The radiance along the unit world direction d (Uniform: `uniform`, the scene's background).
   Color along(const Vec3& d, const Color& uniform) const;
+  // The direction turned by −rotate about +y (where the image is looked up), and back.
+  Vec3 toImage(const Vec3& d) const;
+  Vec3 fromImage(const Vec3& d) const;
+};
+
+// Importance sampling of an image environment for the path integrator's next-event estimation
+// (pbrt's piecewise-constant 2D distribution): directions are drawn with density proportional to
+// the luminance of a level of the image's mip-map at most kEnvironmentSamplingWidth texels wide,
+// weighted by sin θ (the texels' solid angle), so bright parts (the sun, a window) are found by
+// shadow rays instead of by chance. Texels of zero luminance are never drawn; the path
+// integrator's multiple importance sampling leaves those directions to the BRDF samples.
+class EnvironmentSampler {
+ public:
+  static constexpr int kEnvironmentSamplingWidth = 512;
+  // Null unless `environment` is an image with some light in it.
+  static std::shared_ptr<const EnvironmentSampler> make(const Environment& environment);
+
+  // A unit world direction for u in [0,1)², with its density over solid angle (> 0).
+  Vec3 sample(const Point2& u, double& pdf) const;
+  // The density over solid angle of drawing the unit world direction d.
+  double pdf(const Vec3& d) const;
+
+ private:
+  EnvironmentSampler(const Environment& environment, int level);
+  // The first index i of `cdf` (size n + 1, cdf[0] = 0, cdf[n] = 1) with cdf[i + 1] > u.
+  static int find(const double* cdf, int n, double u);
+
+  Environment environment_;  // a copy: the image is shared
+  int width_;
+  int height_;
+  std::vector<double> rowCdf_;       // height_ + 1 values
+  std::vector<double> columnCdf_;    // height_ rows of width_ + 1 values
+  std::vector<double> rowWeight_;    // each row's share of the total
+  std::vector<double> texelWeight_;  // each texel's share of its row
 };
 
 }  // namespace glint

@@ -93,6 +93,9 @@ Scene::Scene(SceneParts parts)
       ambient_(parts.ambient),
       background_(parts.background),
       environment_(std::move(parts.environment)),
+      environmentSampler_(parts.render.integrator == Integrator::Path
+                              ? EnvironmentSampler::make(environment_)
+                              : nullptr),
       fog_(parts.fog),
       camera_(cameraSpecFor(parts)),
       image_(std::move(parts.image)),

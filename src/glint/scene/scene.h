@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -122,6 +123,9 @@ class Scene {
   const Color& ambient() const { return ambient_; }
   const Color& background() const { return background_; }
   const Environment& environment() const { return environment_; }
+  // The image environment's importance sampler for the path integrator; null for other
+  // backgrounds and under the Whitted integrator.
+  const EnvironmentSampler* environmentSampler() const { return environmentSampler_.get(); }
   bool uniformBackground() const { return environment_.kind == BackgroundKind::Uniform; }
   // What a ray leaving the scene along the unit direction d sees.
   Color backgroundAlong(const Vec3& d) const { return environment_.along(d, background_); }
@@ -146,6 +150,7 @@ class Scene {
   Color ambient_;
   Color background_;
   Environment environment_;
+  std::shared_ptr<const EnvironmentSampler> environmentSampler_;
   std::optional<Fog> fog_;
   Camera camera_;
   ImageSettings image_;
