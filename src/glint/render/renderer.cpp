@@ -40,6 +40,7 @@ namespace {
 //   4 + i  area light i (its index in Scene::lights()): the points sampled on its surface
 //   2^30   ambient occlusion: the directions of its rays (above any light index)
 //   2^30+1 path: the direction toward the image environment (next-event estimation)
+//   2^30+2 path: the emitter and the point on it (next-event estimation)
 // The primary hit shares the camera sample's stream (its dimensions start at 2). A secondary ray
 // continues on stream.branch(lobe dimension, count, k): a new key, so the next hit draws its own
 // dimensions 2, 3, 4 + i independently of this hit's; fanned-out sub-samples (glossy rays, area
@@ -52,6 +53,7 @@ constexpr std::uint32_t kRefractionDimension = 3;
 constexpr std::uint32_t kFirstLightDimension = 4;
 constexpr std::uint32_t kOcclusionDimension = std::uint32_t{1} << 30;
 constexpr std::uint32_t kEnvironmentDimension = kOcclusionDimension + 1;
+constexpr std::uint32_t kEmitterDimension = kOcclusionDimension + 2;
 
 // Adaptive anti-aliasing starts with at least this many samples per pixel: fewer give no useful
 // estimate of the pixel's error (four Sobol points already fall one in each quadrant).
@@ -80,6 +82,7 @@ struct TraceContext {
   const AmbientOcclusion* occlusion;      // render.ambient_occlusion, or null
   bool path;                              // render.integrator: path (tracePath) rather than Whitted
   const EnvironmentSampler* environment;  // path: the image background's sampler, or null
+  const EmitterSampler* emitters;         // path: the emissive surfaces' sampler, or null
   int minDepth;                           // path: Russian roulette from this many hits on
   int samplesPerPixel;                    // scales camera ray differentials
 };
@@ -491,8 +494,10 @@ Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double
 // ---- render.integrator: path (DESIGN.md §10) ---------------------------------------------------
 //
 // Unidirectional path tracing, one path per camera sample, iterative. At every hit:
-//   - emission counts in full (emissive surfaces are found by the paths that hit them; they are
-//     not sampled as lights), and so does a uniform or gradient background a path escapes to;
+//   - emissive surfaces are lights (EmitterSampler: a point drawn by luminance per area, one
+//     shadow ray per hit with diffuse or glossy lobes, blocked by any surface), weighted against
+//     the BRDF samples that hit them by the power heuristic; emitters it does not sample count in
+//     full where paths meet them, as does a uniform or gradient background a path escapes to;
 //   - an image background is also sampled as a light (EnvironmentSampler: by luminance): one
 //     shadow ray per hit with diffuse or glossy lobes, blocked by any surface, weighted against
 //     the BRDF samples that escape to it by the power heuristic (multiple importance sampling);
@@ -604,6 +609,34 @@ Color environmentLight(const TraceContext& ctx, const PhongLobes& lobes, const N
   return f * ctx.scene.backgroundAlong(wi) * (powerHeuristic(lightPdf, brdfPdf) / lightPdf);
 }
 
+// Next-event estimation toward the emissive surfaces: one point drawn by luminance per area, its
+// emission if nothing is in the way, weighted against the BRDF's samples by the power heuristic.
+Color emitterLight(const TraceContext& ctx, const PhongLobes& lobes, const Point3& p,
+                   const Normal3& n, double side, SpawnOrigins& origins,
+                   const SampleStream& stream) {
+  const EmitterSampler::Sample light = ctx.emitters->sample(stream.get2D(kEmitterDimension));
+  const Vec3 toLight = light.point - p;
+  const double distance2 = dot(toLight, toLight);
+  if (!(distance2 > 0)) return Color();
+  const double distance = std::sqrt(distance2);
+  const Vec3 wi = toLight / distance;
+  // Emitters shine from both sides, as they show from both.
+  const double cosLight = std::abs(dot(light.normal, wi));
+  if (!(cosLight > 0) || !(dot(n, wi) * side > 0)) return Color();
+  double brdfPdf = 0;
+  const Color f = lobes.weighted(wi, brdfPdf);
+  if (isBlack(f)) return Color();
+  // The density over solid angle at the hit: the area density × d² / cos θ at the light.
+  const double lightPdf = light.areaPdf * distance2 / cosLight;
+  ++ctx.counts.shadow;
+  // Anything before the point blocks it (the last millionth of the way is left out, so that the
+  // emitter's own surface, a rounding error away from the point, does not).
+  Hit blocker;
+  const Ray shadowRay = origins.spawn(wi);
+  if (ctx.scene.intersect(shadowRay, distance * (1 - 1e-6), blocker)) return Color();
+  return f * light.emission * (powerHeuristic(lightPdf, brdfPdf) / lightPdf);
+}
+
 // The radiance along a camera ray (unit direction) by path tracing; see above.
 Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStream& cameraStream,
                 const RayDifferential* differential) {
@@ -654,7 +687,15 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
       material.kd *= tint;
       material.ka *= tint;
     }
-    radiance += throughput * textured.emission;
+    if (brdfPdf > 0 && ctx.emitters != nullptr && !isBlack(textured.emission)) {
+      // Met by a BRDF sample: weighted against the emitter samples that could have drawn it.
+      const double areaPdf = ctx.emitters->areaPdf(hit, scene.emissionOf(hit));
+      const double cosLight = std::abs(dot(hit.normal, ray.direction));
+      const double lightPdf = areaPdf > 0 && cosLight > 0 ? areaPdf * hit.t * hit.t / cosLight : 0;
+      radiance += throughput * textured.emission * powerHeuristic(brdfPdf, lightPdf);
+    } else {
+      radiance += throughput * textured.emission;
+    }
 
     const Point3& p = hit.point;
     const Normal3& n = hit.normal;
@@ -686,6 +727,9 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
     if (ctx.environment != nullptr && diffuse + glossy > 0) {
       radiance += throughput * environmentLight(ctx, lobes, n, side, origins, stream);
     }
+    if (ctx.emitters != nullptr && diffuse + glossy > 0) {
+      radiance += throughput * emitterLight(ctx, lobes, p, n, side, origins, stream);
+    }
     Vec3 w;
     Color factor;
     brdfPdf = 0;
@@ -705,7 +749,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
                                 (total / glossy));
       }
       if (!(dot(n, w) * side > 0)) break;  // below the geometric surface
-      if (ctx.environment != nullptr) lobes.weighted(w, brdfPdf);
+      if (ctx.environment != nullptr || ctx.emitters != nullptr) lobes.weighted(w, brdfPdf);
       ++ctx.counts.reflection;
     } else if (pick < diffuse + glossy + mirror) {
       w = specularLobeDirection(reflected, material.reflectionBlur, n, stream);
@@ -775,6 +819,7 @@ TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>
                       settings.ambientOcclusion ? &*settings.ambientOcclusion : nullptr,
                       settings.integrator == Integrator::Path,
                       scene.environmentSampler(),
+                      scene.emitterSampler(),
                       settings.minDepth,
                       samplesPerPixel(scene.image()).minimum};
 }

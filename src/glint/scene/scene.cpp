@@ -100,6 +100,10 @@ Scene::Scene(SceneParts parts)
       camera_(cameraSpecFor(parts)),
       image_(std::move(parts.image)),
       render_(parts.render),
-      aggregate_(buildAggregate(parts, materials_, textures_, materialTextures_)) {}
+      aggregate_(buildAggregate(parts, materials_, textures_, materialTextures_)),
+      emitterSampler_(render_.integrator == Integrator::Path
+                          ? EmitterSampler::make(aggregate_.primitives(), aggregate_.meshes(),
+                                                 materials_, materialTextures_)
+                          : nullptr) {}
 
 }  // namespace glint

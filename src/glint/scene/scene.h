@@ -13,6 +13,7 @@
 #include "glint/accel/aggregate.h"
 #include "glint/core/color.h"
 #include "glint/scene/camera.h"
+#include "glint/scene/emitters.h"
 #include "glint/scene/environment.h"
 #include "glint/scene/fog.h"
 #include "glint/scene/light.h"
@@ -126,6 +127,9 @@ class Scene {
   // The image environment's importance sampler for the path integrator; null for other
   // backgrounds and under the Whitted integrator.
   const EnvironmentSampler* environmentSampler() const { return environmentSampler_.get(); }
+  // The emissive surfaces sampled as lights by the path integrator; null when there are none and
+  // under the Whitted integrator.
+  const EmitterSampler* emitterSampler() const { return emitterSampler_.get(); }
   bool uniformBackground() const { return environment_.kind == BackgroundKind::Uniform; }
   // What a ray leaving the scene along the unit direction d sees.
   Color backgroundAlong(const Vec3& d) const { return environment_.along(d, background_); }
@@ -156,6 +160,7 @@ class Scene {
   ImageSettings image_;
   RenderSettings render_;
   Aggregate aggregate_;
+  std::shared_ptr<const EmitterSampler> emitterSampler_;  // after aggregate_: built from it
 };
 
 }  // namespace glint

@@ -1,0 +1,72 @@
+// Emissive surfaces as lights for the path integrator (DESIGN.md §10: "emissive objects are lights,
+// sampled by area"): next-event estimation picks a point on an emitter with density proportional
+// to the emission's luminance per unit area (an emitter chosen by its power, luminance × area,
+// then a uniform point on it), so a small bright lamp is found by shadow rays instead of by chance.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "glint/accel/aggregate.h"
+#include "glint/core/color.h"
+#include "glint/core/vec.h"
+#include "glint/geometry/shape.h"
+#include "glint/geometry/triangle_mesh.h"
+#include "glint/scene/material.h"
+#include "glint/scene/texture.h"
+
+namespace glint {
+
+class EmitterSampler {
+ public:
+  // What sample() draws: a point on an emitter, its unit geometric normal, its emission (linear
+  // radiance, both sides) and the density of drawing it, per unit area (scene units²).
+  struct Sample {
+    Point3 point;
+    Normal3 normal;
+    Color emission;
+    double areaPdf = 0;
+  };
+
+  // The emitters it samples: spheres, disks and rings without a transform; triangles, rectangles,
+  // quadrangles and polygons with or without one (an affine map keeps them flat); every triangle
+  // of an emissive mesh. Not sampled (found only by the paths that hit them): infinite shapes,
+  // boxes, cylinders, tubes, cones, a transformed sphere or disk, and emission with a texture.
+  // Null when there is nothing to sample.
+  static std::shared_ptr<const EmitterSampler> make(const std::vector<Primitive>& primitives,
+                                                    const std::vector<TriangleMesh>& meshes,
+                                                    const std::vector<Material>& materials,
+                                                    const std::vector<MaterialTextures>& textures);
+
+  // A point for u in [0,1)² (u.x picks the emitter and is reused inside it).
+  Sample sample(const Point2& u) const;
+  // The area density with which sample() draws the point `hit` is on, whose base emission is
+  // `emission`; 0 when that surface is not sampled. The same at every point of one emitter.
+  double areaPdf(const Hit& hit, const Color& emission) const;
+  std::size_t size() const { return units_.size(); }
+
+ private:
+  enum class Kind : std::uint8_t { Triangle, Sphere, Disk };
+  struct Unit {
+    Kind kind = Kind::Triangle;
+    Point3 a, b, c;  // triangle vertices; sphere and disk: a is the centre
+    Normal3 normal;  // triangle and disk
+    double radius = 0;
+    double innerRadius = 0;  // disk
+    Color emission;
+  };
+  EmitterSampler() = default;
+  void add(const Unit& unit, double area);
+
+  std::vector<Unit> units_;
+  std::vector<double> cdf_;  // units_.size() + 1 running power shares, cdf_[0] = 0
+  double totalPower_ = 0;    // Σ luminance × area
+  std::vector<bool> sampledPrimitive_;
+  std::vector<bool> sampledMesh_;
+};
+
+// Luminance (Rec. 709 weights) of a linear colour.
+inline double luminance(const Color& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+
+}  // namespace glint
