@@ -321,5 +321,40 @@ TEST(PathIntegrator, AnEmissiveSphereAndAnEmissiveTriangleLightAPlaneAsTheirForm
   EXPECT_NEAR(lit.g / (kd / std::numbers::pi * radiance.g * area / (height * height)), 1, 0.01);
 }
 
+// MIS, light sampling alone and BRDF sampling alone estimate the same image: on a scene with a
+// small bright emitter, a large dim one and an image sky over a diffuse floor and a glossy ball,
+// their means over a 16×16 image at 256 samples agree within 3 %.
+TEST(PathIntegrator, MisAndEachStrategyAloneConvergeToTheSameImage) {
+  SceneParts parts = cameraParts(16, 16);
+  parts.camera.position = {0, 1.5, 5};
+  parts.camera.direction = normalize(Vec3{0, -0.3, -1});
+  parts.image.samples = 256;
+  parts.environment = skyWithSun(32, 16, 0.1f, 50, 10, 3, 2);
+  Material glossy = diffuse(Color(0.1, 0.2, 0.4));
+  glossy.ks = Color(0.5);
+  glossy.shininess = 40;
+  parts.primitives.emplace_back(Plane::make({0, 0, 0}, {0, 1, 0}),
+                                addMaterial(parts, diffuse(Color(0.6))), Color{});
+  parts.primitives.emplace_back(Sphere::make({0.6, 0.5, -0.5}, 0.5), addMaterial(parts, glossy),
+                                Color{});
+  const std::uint32_t dark = addMaterial(parts, diffuse(Color(0)));
+  parts.primitives.emplace_back(Sphere::make({-1.2, 1.4, 0}, 0.3), dark, Color(40, 36, 30));
+  parts.primitives.emplace_back(Rectangle::make({-2, 3, -2}, {4, 0, 0}, {0, 0, 4}), dark,
+                                Color(0.5, 0.55, 0.6));
+  Color means[3];
+  const PathLightSampling kinds[] = {PathLightSampling::Mis, PathLightSampling::LightsOnly,
+                                     PathLightSampling::BrdfOnly};
+  for (int k = 0; k < 3; ++k) {
+    SceneParts copy = parts;
+    copy.render.lightSampling = kinds[k];
+    means[k] = meanOf(render(Scene(std::move(copy))));
+  }
+  for (int k = 1; k < 3; ++k) {
+    EXPECT_NEAR(means[k].r / means[0].r, 1, 0.03) << k;
+    EXPECT_NEAR(means[k].g / means[0].g, 1, 0.03) << k;
+    EXPECT_NEAR(means[k].b / means[0].b, 1, 0.03) << k;
+  }
+}
+
 }  // namespace
 }  // namespace glint

@@ -83,6 +83,7 @@ struct TraceContext {
   bool path;                              // render.integrator: path (tracePath) rather than Whitted
   const EnvironmentSampler* environment;  // path: the image background's sampler, or null
   const EmitterSampler* emitters;         // path: the emissive surfaces' sampler, or null
+  PathLightSampling lightSampling;        // path: MIS, or one strategy alone
   int minDepth;                           // path: Russian roulette from this many hits on
   int samplesPerPixel;                    // scales camera ray differentials
 };
@@ -563,6 +564,34 @@ double powerHeuristic(double own, double other) {
   return a / (a + other * other);
 }
 
+// The weight of a light sample (next-event estimation) drawn with density lightPdf, which the
+// BRDF would have drawn with density brdfPdf.
+double lightSampleWeight(const TraceContext& ctx, double lightPdf, double brdfPdf) {
+  switch (ctx.lightSampling) {
+    case PathLightSampling::LightsOnly:
+      return 1;
+    case PathLightSampling::BrdfOnly:
+      return 0;
+    case PathLightSampling::Mis:
+      break;
+  }
+  return powerHeuristic(lightPdf, brdfPdf);
+}
+
+// The weight of a BRDF sample (density brdfPdf) that met a light the light samples draw with
+// density lightPdf (0: they never draw it, and the BRDF sample counts in full).
+double brdfSampleWeight(const TraceContext& ctx, double brdfPdf, double lightPdf) {
+  switch (ctx.lightSampling) {
+    case PathLightSampling::LightsOnly:
+      return lightPdf > 0 ? 0 : 1;
+    case PathLightSampling::BrdfOnly:
+      return 1;
+    case PathLightSampling::Mis:
+      break;
+  }
+  return powerHeuristic(brdfPdf, lightPdf);
+}
+
 // The diffuse and glossy part of the normalised Phong BRDF at one hit, and the density with which
 // the path's lobe choice draws a direction from those two lobes.
 struct PhongLobes {
@@ -606,7 +635,7 @@ Color environmentLight(const TraceContext& ctx, const PhongLobes& lobes, const N
   // Any surface blocks it: light through glass reaches the hit along the glass's own lobes.
   Hit blocker;
   if (ctx.scene.intersect(origins.spawn(wi), kInfinity, blocker)) return Color();
-  return f * ctx.scene.backgroundAlong(wi) * (powerHeuristic(lightPdf, brdfPdf) / lightPdf);
+  return f * ctx.scene.backgroundAlong(wi) * (lightSampleWeight(ctx, lightPdf, brdfPdf) / lightPdf);
 }
 
 // Next-event estimation toward the emissive surfaces: one point drawn by luminance per area, its
@@ -634,7 +663,7 @@ Color emitterLight(const TraceContext& ctx, const PhongLobes& lobes, const Point
   Hit blocker;
   const Ray shadowRay = origins.spawn(wi);
   if (ctx.scene.intersect(shadowRay, distance * (1 - 1e-6), blocker)) return Color();
-  return f * light.emission * (powerHeuristic(lightPdf, brdfPdf) / lightPdf);
+  return f * light.emission * (lightSampleWeight(ctx, lightPdf, brdfPdf) / lightPdf);
 }
 
 // The radiance along a camera ray (unit direction) by path tracing; see above.
@@ -657,9 +686,10 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
       } else if (ctx.uniformBackground) {
         radiance += throughput * scene.background();
       } else {
-        const double misWeight = brdfPdf > 0 && ctx.environment != nullptr
-                                     ? powerHeuristic(brdfPdf, ctx.environment->pdf(ray.direction))
-                                     : 1;
+        const double misWeight =
+            brdfPdf > 0 && ctx.environment != nullptr
+                ? brdfSampleWeight(ctx, brdfPdf, ctx.environment->pdf(ray.direction))
+                : 1;
         radiance += throughput * scene.backgroundAlong(ray.direction) * misWeight;
       }
       break;
@@ -692,7 +722,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
       const double areaPdf = ctx.emitters->areaPdf(hit, scene.emissionOf(hit));
       const double cosLight = std::abs(dot(hit.normal, ray.direction));
       const double lightPdf = areaPdf > 0 && cosLight > 0 ? areaPdf * hit.t * hit.t / cosLight : 0;
-      radiance += throughput * textured.emission * powerHeuristic(brdfPdf, lightPdf);
+      radiance += throughput * textured.emission * brdfSampleWeight(ctx, brdfPdf, lightPdf);
     } else {
       radiance += throughput * textured.emission;
     }
@@ -724,10 +754,12 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
     const Vec3 reflected = mirrorDirection(v, n, ns, nv, nsv, smooth);
     const Vec3 up = toVec(ns) * side;
     const PhongLobes lobes{material, up, reflected, diffuse / total, glossy / total};
-    if (ctx.environment != nullptr && diffuse + glossy > 0) {
+    const bool sampleLights =
+        diffuse + glossy > 0 && ctx.lightSampling != PathLightSampling::BrdfOnly;
+    if (ctx.environment != nullptr && sampleLights) {
       radiance += throughput * environmentLight(ctx, lobes, n, side, origins, stream);
     }
-    if (ctx.emitters != nullptr && diffuse + glossy > 0) {
+    if (ctx.emitters != nullptr && sampleLights) {
       radiance += throughput * emitterLight(ctx, lobes, p, n, side, origins, stream);
     }
     Vec3 w;
@@ -820,6 +852,7 @@ TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>
                       settings.integrator == Integrator::Path,
                       scene.environmentSampler(),
                       scene.emitterSampler(),
+                      settings.lightSampling,
                       settings.minDepth,
                       samplesPerPixel(scene.image()).minimum};
 }

@@ -61,6 +61,11 @@ struct AmbientOcclusion {
 // tracing with the normalised Phong BRDF.
 enum class Integrator { Whitted, Path };
 
+// How the path integrator combines its two ways of finding emitters and the image sky: multiple
+// importance sampling (the default), or one of them alone — for tests and benchmarks that
+// compare them (all three converge to the same image); not a scene key.
+enum class PathLightSampling { Mis, LightsOnly, BrdfOnly };
+
 struct RenderSettings {
   Integrator integrator = Integrator::Whitted;
   int minDepth = 3;          // path: Russian roulette from this many surface hits on
@@ -69,6 +74,7 @@ struct RenderSettings {
   int blurSamples = 16;      // rays per glossy reflection/refraction
   std::uint64_t seed = 0;    // varies every random number, deterministically
   std::optional<AmbientOcclusion> ambientOcclusion;  // none by default
+  PathLightSampling lightSampling = PathLightSampling::Mis;
 };
 
 // Everything needed to build a Scene. The scene builder fills this from a scene file; programs may
