@@ -125,12 +125,15 @@ void convergence(int width, int height, int threads, bool quick) {
     sxy += xs[i] * ys[i];
   }
   const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-  std::printf("   log-log slope of the error: %.3f (an unbiased estimate: -0.5)\n\n", slope);
+  std::printf(
+      "   log-log slope of the error: %.3f (independent random samples: -0.5; the scrambled "
+      "Sobol samples converge faster)\n\n",
+      slope);
 }
 
 // A room corner lit by a small bright sphere (radius 0.05, radiance 4000) and a large dim panel
-// (4 × 4, radiance 0.5), over a diffuse floor and wall and a glossy ball (Phong exponent 200): light
-// sampling finds the small light, BRDF sampling the panel's reflection in the ball.
+// (4 × 4, radiance 0.5), over a diffuse floor and wall and a glossy ball (Phong exponent 200):
+// light sampling finds the small light, BRDF sampling the panel's reflection in the ball.
 SceneParts twoLightScene(int width, int height) {
   SceneParts parts;
   parts.camera.position = {0, 1.5, 5};

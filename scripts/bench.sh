@@ -8,7 +8,7 @@
 #   --build-dir DIR  build tree to use (default build/, the release preset's)
 #   --no-build       run what DIR already holds
 #   --only NAMES     comma-separated subset of: ray_throughput, build_memory, bvh_scaling,
-#                    renderer_comparison, adaptive_sampling
+#                    renderer_comparison, adaptive_sampling, path_tracing
 #
 # Needs Embree 3, Tachyon and POV-Ray (scripts/setup.sh bench installs them). Everything printed is
 # also saved to DIR/bench-results/bench-DATE.txt; the renderer comparison leaves its scenes, logs and
@@ -26,7 +26,7 @@ quick=()
 runs=()
 build_dir=build
 build=1
-only=ray_throughput,build_memory,bvh_scaling,renderer_comparison,adaptive_sampling
+only=ray_throughput,build_memory,bvh_scaling,renderer_comparison,adaptive_sampling,path_tracing
 while (($#)); do
   case "$1" in
     --quick) quick=(--quick) ;;
@@ -99,6 +99,7 @@ run() {
   run renderer_comparison "$bench_bin/renderer_comparison" "${quick[@]}" "${runs[@]}" \
     --out "$results/renderer_comparison"
   run adaptive_sampling "$bench_bin/adaptive_sampling" "${quick[@]}" "${runs[@]}"
+  run path_tracing "$bench_bin/path_tracing" "${quick[@]}" "${runs[@]}"
   printf '\nuptime: %s\n' "$(uptime)"
 } 2>&1 | tee "$log"
 printf 'bench: results saved to %s\n' "$log" >&2

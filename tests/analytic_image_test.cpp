@@ -481,7 +481,7 @@ TEST(AnalyticImage, SupersamplingKeepsTheMeanOfAUniformPlane) {
       // Adaptive: every pixel's samples agree, so none takes more than the initial count (at
       // least 4).
       const auto perPixel = static_cast<std::uint64_t>(adaptive ? std::max(samples, 4) : samples);
-      EXPECT_EQ(stats.rays.camera, 21u * 21u * perPixel) << samples << ", adaptive " << adaptive;
+      EXPECT_EQ(stats.samples, 21u * 21u * perPixel) << samples << ", adaptive " << adaptive;
     }
   }
 }

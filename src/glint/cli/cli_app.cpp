@@ -237,11 +237,11 @@ std::string summaryText(const RenderJobResult& result) {
       "{} refraction; {}\n",
       result.output.string(), regionText(scene, result.crop), formatDuration(stats.seconds),
       rays.camera, rays.shadow, rays.reflection, rays.refraction, rate);
-  // Adaptive sampling spends a varying number of samples per pixel; rays.camera counts them.
+  // Adaptive sampling spends a varying number of samples per pixel.
   if (scene.image.adaptive && result.pixelsRendered > 0)
     text +=
-        fmt::format("glint: samples: {} ({:.2f} per pixel on average, {} to {})\n", rays.camera,
-                    static_cast<double>(rays.camera) / static_cast<double>(result.pixelsRendered),
+        fmt::format("glint: samples: {} ({:.2f} per pixel on average, {} to {})\n", stats.samples,
+                    static_cast<double>(stats.samples) / static_cast<double>(result.pixelsRendered),
                     scene.samplesPerPixel.minimum, scene.samplesPerPixel.maximum);
   if (stats.nonFinite > 0) {
     text += fmt::format("glint: {} NaN/inf {} replaced by black", stats.nonFinite,
@@ -279,8 +279,8 @@ void printStats(const RenderJobResult& result, int threads) {
                       scene.maxDepth, scene.seed);
   text += fmt::format("glint: rays: {} total, {:.1f} per pixel\n", stats.rays.total(),
                       static_cast<double>(stats.rays.total()) / pixels);
-  text += fmt::format("glint: samples: {} total, {:.2f} per pixel\n", stats.rays.camera,
-                      static_cast<double>(stats.rays.camera) / pixels);
+  text += fmt::format("glint: samples: {} total, {:.2f} per pixel\n", stats.samples,
+                      static_cast<double>(stats.samples) / pixels);
   text += fmt::format("glint: time: load {}, build {}, render {}, write {}\n",
                       formatDuration(timings.load), formatDuration(timings.build),
                       formatDuration(timings.render), formatDuration(timings.write));

@@ -196,6 +196,7 @@ std::string encodeReport(const RankReport& report) {
   Writer w;
   w.u64(report.tiles);
   writeRays(w, report.rays);
+  w.u64(report.samples);
   w.u64(report.nonFinite);
   w.u32(report.firstNonFinite ? 1 : 0);
   w.i32(report.firstNonFinite ? report.firstNonFinite->x : 0);
@@ -212,6 +213,7 @@ RankReport decodeReport(std::string_view bytes) {
   RankReport report;
   report.tiles = r.u64();
   report.rays = readRays(r);
+  report.samples = r.u64();
   report.nonFinite = r.u64();
   const bool hasFirst = r.u32() != 0;
   const int x = r.i32();

@@ -72,6 +72,7 @@ struct TileResult {
 struct RankReport {
   std::uint64_t tiles = 0;  // rendered by it
   RayCounts rays;
+  std::uint64_t samples = 0;  // camera samples that went into its tiles' pixels
   std::uint64_t nonFinite = 0;
   std::optional<PixelCoord> firstNonFinite;
   double renderSeconds = 0;  // wall time of its render

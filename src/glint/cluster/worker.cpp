@@ -118,6 +118,7 @@ class TileRender {
     RankReport report;
     report.tiles = tilesDone_;
     report.rays = stats_.rays;
+    report.samples = stats_.samples;
     report.nonFinite = stats_.nonFinite;
     report.firstNonFinite = stats_.firstNonFinite;
     report.renderSeconds = seconds_;

@@ -945,20 +945,21 @@ double standardError(const Color& sum, const Color& sumSquares, std::uint32_t n)
       {channel(sum.r, sumSquares.r), channel(sum.g, sumSquares.g), channel(sum.b, sumSquares.b)}));
 }
 
-// The estimate of one pixel: the mean of its samples. Without adaptive sampling, exactly
-// image.samples samples. Adaptive (image.adaptive): `initial` samples, then batches of `batch`
-// more while the largest per-channel standard error of the pixel's mean (from the sample variance
-// of its own samples, linear color) exceeds the threshold, up to `maximum`. The decision reads only
-// this pixel's samples, so it is the same on any thread count, tile schedule or crop. (With
-// stratified Sobol samples the sample variance overestimates the mean's true error: the rule errs
-// toward more samples.) Sample s uses the sampler stream (pixel, s, seed); non-finite samples count
-// as black and are added to `nonFinite`.
-//
-// `cancel` is polled before every sample (one relaxed load beside a whole camera path), so a pixel
-// of millions of rays still stops within one sample; false when it did, leaving `color` unset.
-bool renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
-                 std::uint64_t seed, const std::atomic<bool>* cancel, std::uint64_t& nonFinite,
-                 Color& color) {
+// The running sums of one pixel's samples: Σx, Σx² (adaptive sampling only) and their number.
+struct PixelSamples {
+  Color sum;
+  Color sumSquares;
+  std::uint32_t n = 0;
+  std::uint64_t nonFinite = 0;  // samples that were not finite (counted as black)
+};
+
+// Adds the pixel's samples n … target − 1 to `samples`. Sample s uses the sampler stream
+// (pixel, s, seed); non-finite samples count as black and are counted. `cancel` is polled before
+// every sample (one relaxed load beside a whole camera path), so a pixel of millions of rays still
+// stops within one sample; false when it did.
+bool addSamples(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
+                std::uint64_t seed, const std::atomic<bool>* cancel, PixelSamples& samples,
+                std::uint32_t target) {
   const Camera& camera = ctx.scene.camera();
   // The key and the two camera dimensions are the same for every sample of the pixel. A render
   // that draws no sample never reads the key: its hash is skipped.
@@ -972,42 +973,110 @@ bool renderPixel(const TraceContext& ctx, const SamplingPlan& plan, int column, 
   const SobolDimension2D offsets =
       plan.jitter ? pixel.dimension(kPixelDimension) : SobolDimension2D(0);
   const SobolDimension2D lens = lensed ? pixel.dimension(kLensDimension) : SobolDimension2D(0);
-  Color sum;
-  Color sumSquares;
-  std::uint32_t n = 0;
-  std::uint32_t target = plan.initial;
-  for (;;) {
-    for (; n < target; ++n) {
-      if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return false;
-      const SampleStream stream(pixel.key(), n);
-      const Point2 offset = plan.jitter ? offsets.at(n) : Point2{0.5, 0.5};
-      const Point2 lensPoint = lensed ? lens.at(n) : Point2{0.5, 0.5};
-      const Ray ray = camera.generateRay(column, row, offset, lensPoint);
-      Color value;
-      if (ctx.textured) {
-        // The rays through the same point of the pixels to the right and below, same lens point.
-        const RayDifferential differential = cameraDifferential(
-            ray, camera.generateRay(column, row, Point2{offset.x + 1, offset.y}, lensPoint),
-            camera.generateRay(column, row, Point2{offset.x, offset.y + 1}, lensPoint),
-            ctx.samplesPerPixel);
-        value = traceCameraRay(ctx, ray, stream, &differential);
-      } else {
-        value = traceCameraRay(ctx, ray, stream);
-      }
-      if (!isFinite(value)) {
-        value = Color{};
-        ++nonFinite;
-      }
-      sum += value;
-      if (plan.adaptive) sumSquares += value * value;
+  for (std::uint32_t& n = samples.n; n < target; ++n) {
+    if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return false;
+    const SampleStream stream(pixel.key(), n);
+    const Point2 offset = plan.jitter ? offsets.at(n) : Point2{0.5, 0.5};
+    const Point2 lensPoint = lensed ? lens.at(n) : Point2{0.5, 0.5};
+    const Ray ray = camera.generateRay(column, row, offset, lensPoint);
+    Color value;
+    if (ctx.textured) {
+      // The rays through the same point of the pixels to the right and below, same lens point.
+      const RayDifferential differential = cameraDifferential(
+          ray, camera.generateRay(column, row, Point2{offset.x + 1, offset.y}, lensPoint),
+          camera.generateRay(column, row, Point2{offset.x, offset.y + 1}, lensPoint),
+          ctx.samplesPerPixel);
+      value = traceCameraRay(ctx, ray, stream, &differential);
+    } else {
+      value = traceCameraRay(ctx, ray, stream);
     }
-    if (!plan.adaptive || n >= plan.maximum) break;
-    if (!(standardError(sum, sumSquares, n) > plan.threshold)) break;
-    target = std::min(n + plan.batch, plan.maximum);
+    if (!isFinite(value)) {
+      value = Color{};
+      ++samples.nonFinite;
+    }
+    samples.sum += value;
+    if (plan.adaptive) samples.sumSquares += value * value;
   }
-  color = sum / static_cast<double>(n);
   return true;
 }
+
+// The estimate of one pixel: the mean of its samples. Without adaptive sampling, exactly
+// image.samples samples. Adaptive (image.adaptive): `initial` samples (already in `samples`),
+// then batches of `batch` more while the largest per-channel standard error of the pixel's mean
+// (from the sample variance of its own samples, linear color) exceeds the threshold, up to
+// `maximum`. The first decision also looks at `neighbourError`, the largest standard error of
+// the first batches of the pixel's eight neighbours: a pixel whose own first samples happen to
+// agree (a speckle on a blurred edge, a sliver of a penumbra) goes on when its neighbours are
+// noisy. Every first batch is a pure function of its pixel, so the decision is the same on any
+// thread count, tile schedule, crop or MPI split. (With stratified Sobol samples the sample
+// variance overestimates the mean's true error: the rule errs toward more samples.) False when
+// cancelled, leaving `color` unset.
+bool finishPixel(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
+                 std::uint64_t seed, const std::atomic<bool>* cancel, PixelSamples& samples,
+                 double neighbourError, Color& color) {
+  if (!addSamples(ctx, plan, column, row, seed, cancel, samples, plan.initial)) return false;
+  if (plan.adaptive) {
+    bool first = true;
+    while (samples.n < plan.maximum) {
+      const double error = standardError(samples.sum, samples.sumSquares, samples.n);
+      if (!(error > plan.threshold) && !(first && neighbourError > plan.threshold)) break;
+      first = false;
+      if (!addSamples(ctx, plan, column, row, seed, cancel, samples,
+                      std::min(samples.n + plan.batch, plan.maximum))) {
+        return false;
+      }
+    }
+  }
+  color = samples.sum / static_cast<double>(samples.n);
+  return true;
+}
+
+// The first batches of adaptive sampling over a tile and the one-pixel ring around it (inside
+// the image; the ring's pixels belong to other tiles, and their batches are recomputed here, the
+// same bits), and the neighbour error finishPixel reads for each pixel of the tile.
+class FirstBatches {
+ public:
+  FirstBatches(const PixelRegion& tile, int imageWidth, int imageHeight)
+      : x0_(std::max(tile.x0 - 1, 0)),
+        y0_(std::max(tile.y0 - 1, 0)),
+        x1_(std::min(tile.x1 + 1, imageWidth)),
+        y1_(std::min(tile.y1 + 1, imageHeight)),
+        samples_(static_cast<std::size_t>(x1_ - x0_) * static_cast<std::size_t>(y1_ - y0_)),
+        errors_(samples_.size()) {}
+
+  // Renders them; false when cancelled.
+  bool render(const TraceContext& ctx, const SamplingPlan& plan, std::uint64_t seed,
+              const std::atomic<bool>* cancel) {
+    for (int row = y0_; row < y1_; ++row) {
+      for (int column = x0_; column < x1_; ++column) {
+        PixelSamples& s = samples_[index(column, row)];
+        if (!addSamples(ctx, plan, column, row, seed, cancel, s, plan.initial)) return false;
+        errors_[index(column, row)] = standardError(s.sum, s.sumSquares, s.n);
+      }
+    }
+    return true;
+  }
+  PixelSamples& at(int column, int row) { return samples_[index(column, row)]; }
+  // The largest first-batch standard error of the pixel's eight neighbours inside the image.
+  double neighbourError(int column, int row) const {
+    double largest = 0;
+    for (int y = std::max(row - 1, y0_); y <= std::min(row + 1, y1_ - 1); ++y) {
+      for (int x = std::max(column - 1, x0_); x <= std::min(column + 1, x1_ - 1); ++x) {
+        if (x != column || y != row) largest = std::max(largest, errors_[index(x, y)]);
+      }
+    }
+    return largest;
+  }
+
+ private:
+  std::size_t index(int column, int row) const {
+    return static_cast<std::size_t>(row - y0_) * static_cast<std::size_t>(x1_ - x0_) +
+           static_cast<std::size_t>(column - x0_);
+  }
+  int x0_, y0_, x1_, y1_;
+  std::vector<PixelSamples> samples_;
+  std::vector<double> errors_;
+};
 
 }  // namespace
 
@@ -1116,6 +1185,7 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
   const std::uint64_t seed = scene.render().seed;
 
   std::atomic<std::uint64_t> cameraRays{0}, shadowRays{0}, reflectionRays{0}, refractionRays{0};
+  std::atomic<std::uint64_t> pixelSamples{0};
   std::atomic<std::uint64_t> nonFinite{0};
   std::atomic<bool> cancelled{false};
   std::mutex progressMutex;  // guards tilesDone, firstNonFinite and the callbacks
@@ -1156,20 +1226,34 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
     std::vector<Hit> hits = hitStorage(scene);
     const TraceContext ctx = makeContext(scene, counts, hits);
     std::uint64_t tileNonFinite = 0;
+    std::uint64_t tileSamples = 0;
     std::optional<PixelCoord> tileFirstNonFinite;
     bool abandoned = false;
+    std::optional<FirstBatches> firstBatches;  // adaptive sampling only
+    if (plan.adaptive) {
+      firstBatches.emplace(tiles[tile], scene.image().width, scene.image().height);
+      if (!firstBatches->render(ctx, plan, seed, options.cancel)) {
+        cancelled.store(true);
+        abandoned = true;
+      }
+    }
     for (int row = y0; row < y1 && !abandoned; ++row) {
       for (int column = x0; column < x1; ++column) {
         // Another thread's stop, polled per pixel; the caller's cancel flag is polled per sample
-        // inside renderPixel.
-        std::uint64_t pixelNonFinite = 0;
+        // inside finishPixel.
+        PixelSamples own;
+        PixelSamples& samples = firstBatches ? firstBatches->at(column, row) : own;
+        const double neighbourError =
+            firstBatches ? firstBatches->neighbourError(column, row) : 0.0;
         if (cancelled.load(std::memory_order_relaxed) ||
-            !renderPixel(ctx, plan, column, row, seed, options.cancel, pixelNonFinite,
+            !finishPixel(ctx, plan, column, row, seed, options.cancel, samples, neighbourError,
                          film.at(column - region.x0, row - region.y0))) {
           cancelled.store(true);
           abandoned = true;
           break;
         }
+        const std::uint64_t pixelNonFinite = samples.nonFinite;
+        tileSamples += samples.n;
         if (pixelNonFinite > 0 && tileNonFinite == 0) {
           tileFirstNonFinite = PixelCoord{column, row};
         }
@@ -1184,6 +1268,7 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
     refractionRays += counts.refraction;
     if (abandoned) return;
     nonFinite += tileNonFinite;
+    pixelSamples += tileSamples;
     const std::lock_guard<std::mutex> lock(progressMutex);
     if (tileFirstNonFinite && (!firstNonFinite || before(*tileFirstNonFinite, *firstNonFinite))) {
       firstNonFinite = tileFirstNonFinite;
@@ -1224,6 +1309,7 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
 
   if (stats) {
     stats->rays.camera = cameraRays.load();
+    stats->samples = pixelSamples.load();
     stats->rays.shadow = shadowRays.load();
     stats->rays.reflection = reflectionRays.load();
     stats->rays.refraction = refractionRays.load();

@@ -33,8 +33,10 @@ struct PixelCoord {
 };
 
 struct RenderStats {
-  RayCounts rays;      // rays.camera is also the number of pixel samples spent (adaptive: in total)
-  double seconds = 0;  // wall-clock time of the render
+  RayCounts rays;  // every ray traced (adaptive sampling also recomputes neighbours' first
+                   // batches, whose camera rays count here but not in `samples`)
+  std::uint64_t samples = 0;    // camera samples that went into the rendered pixels
+  double seconds = 0;           // wall-clock time of the render
   std::uint64_t nonFinite = 0;  // samples that came out NaN/inf and were replaced by black
   // Where the first non-finite sample arose: the smallest row, then column, among the pixels that
   // had one (so the same on any thread count).
