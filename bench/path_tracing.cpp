@@ -220,10 +220,10 @@ void throughput(int runs, bool quick) {
     }
   }
   std::printf(
-      "   memory: the film holds %zu B per pixel (linear RGB doubles; +%zu B with adaptive "
-      "sampling's sums); a path needs one Hit (%zu B) and its shading state on the worker's "
-      "stack, nothing on the heap\n",
-      sizeof(Color), 2 * sizeof(Color), sizeof(Hit));
+      "   memory: the film holds %zu B per pixel (linear RGB doubles); a path needs one Hit (%zu "
+      "B) "
+      "and its shading state on the worker's stack, nothing on the heap\n",
+      sizeof(Color), sizeof(Hit));
 }
 
 }  // namespace
