@@ -95,7 +95,7 @@ TEST(PathIntegrator, DirectLightIsTheWhittedIntegratorsForEveryLightKind) {
   lights.push_back(spot);
   AreaLight area;
   area.shape = AreaShape::Rectangle;
-  area.corner = {-1, 2, -6};
+  area.corner = {-1, 2, -1.5};  // above the view: the camera does not see it
   area.edge1 = {2, 0, 0};
   area.edge2 = {0, 0, 2};
   area.intensity = Color(1.5, 1.5, 1.5);
@@ -284,14 +284,19 @@ TEST(PathIntegrator, AnEmissiveSphereAndAnEmissiveTriangleLightAPlaneAsTheirForm
   constexpr double radius = 0.1;
   constexpr double height = 2;
   const Color radiance(8, 4, 2);
-  SceneParts parts = cameraParts(8, 8);
-  parts.camera.position = {0, 1, 0};
-  parts.camera.direction = {0, -1, 0};
-  parts.camera.up = {0, 0, -1};
-  parts.camera.viewPlaneWidth = parts.camera.viewPlaneHeight = 1e-4;
-  parts.image.samples = 256;
-  parts.primitives.emplace_back(Plane::make({0, 0, 0}, {0, 1, 0}),
-                                addMaterial(parts, diffuse(Color(kd))), Color{});
+  // A diffuse plane y = 0 seen straight down at the origin through a tiny view, 256 samples.
+  const auto planeSeenAtTheOrigin = [&] {
+    SceneParts p = cameraParts(8, 8);
+    p.camera.position = {0, 1, 0};
+    p.camera.direction = {0, -1, 0};
+    p.camera.up = {0, 0, -1};
+    p.camera.viewPlaneWidth = p.camera.viewPlaneHeight = 1e-4;
+    p.image.samples = 256;
+    p.primitives.emplace_back(Plane::make({0, 0, 0}, {0, 1, 0}), addMaterial(p, diffuse(Color(kd))),
+                              Color{});
+    return p;
+  };
+  SceneParts parts = planeSeenAtTheOrigin();
   parts.primitives.emplace_back(Sphere::make({0, height, 0}, radius), 0u, radiance);
   const Scene scene(std::move(parts));
   ASSERT_NE(scene.emitterSampler(), nullptr);
@@ -302,14 +307,7 @@ TEST(PathIntegrator, AnEmissiveSphereAndAnEmissiveTriangleLightAPlaneAsTheirForm
 
   // A small emissive triangle facing down, of area A at height h, straight overhead: E ≈ L·A/h²
   // (solid angle A/h², both cosines 1); exact to 0.1 % for a side of 0.04 at h = 2.
-  SceneParts flat = cameraParts(8, 8);
-  flat.camera.position = {0, 1, 0};
-  flat.camera.direction = {0, -1, 0};
-  flat.camera.up = {0, 0, -1};
-  flat.camera.viewPlaneWidth = flat.camera.viewPlaneHeight = 1e-4;
-  flat.image.samples = 256;
-  flat.primitives.emplace_back(Plane::make({0, 0, 0}, {0, 1, 0}),
-                               addMaterial(flat, diffuse(Color(kd))), Color{});
+  SceneParts flat = planeSeenAtTheOrigin();
   constexpr double side = 0.04;
   flat.primitives.emplace_back(
       Triangle::make({-side / 2, height, -side / 3}, {side / 2, height, -side / 3},
@@ -354,6 +352,38 @@ TEST(PathIntegrator, MisAndEachStrategyAloneConvergeToTheSameImage) {
     EXPECT_NEAR(means[k].g / means[0].g, 1, 0.03) << k;
     EXPECT_NEAR(means[k].b / means[0].b, 1, 0.03) << k;
   }
+}
+
+// Under `path` an area light is a surface camera rays and mirror rays see, of radiance colour ×
+// intensity; under Whitted it is invisible (the background shows).
+TEST(PathIntegrator, AreaLightsAreSeenByCameraAndMirrorRays) {
+  const auto scene = [](Integrator integrator, bool mirror) {
+    SceneParts parts = cameraParts(4, 4);
+    parts.render.integrator = integrator;
+    parts.background = Color(0.1, 0.1, 0.1);
+    AreaLight lamp;
+    lamp.shape = AreaShape::Disk;
+    lamp.center = {0, 0, mirror ? 5.0 : -5.0};
+    lamp.normal = {0, 0, 1};
+    lamp.radius = 50;  // fills the view
+    lamp.intensity = Color(2, 3, 4);
+    parts.lights.push_back(lamp);
+    if (mirror) {
+      // A mirror across the view at z = −5 reflects the lamp behind the camera.
+      Material chrome;
+      chrome.kd = Color(0);
+      chrome.kr = Color(0.5);
+      parts.primitives.emplace_back(Plane::make({0, 0, -5}, {0, 0, 1}), addMaterial(parts, chrome),
+                                    Color{});
+    }
+    return Scene(std::move(parts));
+  };
+  const Film seen = render(scene(Integrator::Path, false));
+  for (const Color& c : seen.pixels()) EXPECT_EQ(c, Color(2, 3, 4));
+  const Film unseen = render(scene(Integrator::Whitted, false));
+  for (const Color& c : unseen.pixels()) EXPECT_EQ(c, Color(0.1, 0.1, 0.1));
+  const Film mirrored = render(scene(Integrator::Path, true));
+  for (const Color& c : mirrored.pixels()) EXPECT_EQ(c, Color(1, 1.5, 2));
 }
 
 }  // namespace

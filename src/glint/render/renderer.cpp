@@ -513,7 +513,10 @@ Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double
 //     kt as specular lobes with their blur cones, each divided by the lobe's probability;
 //   - from render.min_depth hits on, Russian roulette ends the path with probability
 //     1 − min(1, max component of its throughput) and divides the survivors by the rest;
-//   - fog, linear in what lies behind it, fades each segment: L += T·(1 − f)·fog; T *= f.
+//   - fog, linear in what lies behind it, fades each segment: L += T·(1 − f)·fog; T *= f;
+//   - camera rays and the rays of the kr/kt lobes see the area lights as surfaces of radiance
+//     colour × intensity (Scene::lightSurfaces) and end there; the kd/ks lobes' rays pass them
+//     (their light is in the direct term), and so do all shadow rays (as under Whitted).
 // Sample dimensions at each hit (the stream of the path there): 2 the lobe direction, 3 the lobe
 // choice (x) and the roulette (y), 4 + i area light i as in Whitted's, 2^30 + 1 the environment
 // direction; the next hit's stream is branch(2, 1, 0). The same bytes on any thread count, crop and
@@ -679,8 +682,42 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
   // importance sampling where it meets the image environment; 0 for camera rays and specular
   // lobes, which the environment's samples never stand in for.
   double brdfPdf = 0;
+  // Camera rays and the rays of specular lobes see the area lights (Scene::lightSurfaces); the
+  // diffuse and glossy lobes' rays do not (the lights' direct term already counts their light).
+  bool seesLights = true;
+  // Fog over a segment of length t (scene units) of the path at `depth`: what lies behind fades.
+  const auto fogSegment = [&](double t, int depth) {
+    const Fog& fog = *scene.fog();
+    const bool viewDepth = fog.distance == FogDistance::Depth && depth == 0;
+    const double f =
+        fog.visibility(viewDepth ? t * dot(ray.direction, scene.camera().toward()) : t);
+    radiance += throughput * fog.color * (1 - f);
+    throughput *= f;
+  };
   for (int depth = 0;; ++depth) {
-    if (!scene.intersect(ray, kInfinity, hit)) {
+    const bool found = scene.intersect(ray, kInfinity, hit);
+    if (seesLights && !scene.lightSurfaces().empty()) {
+      // The nearest area light in front of the hit is what the ray sees; a light reflects
+      // nothing, so the path ends there.
+      double nearest = found ? hit.t : kInfinity;
+      const Color* lamp = nullptr;
+      for (const Scene::LightSurface& surface : scene.lightSurfaces()) {
+        ShapeHit lightHit;
+        const bool crossed = std::visit(
+            [&](const auto& shape) { return shape.intersect(ray, 0, nearest, lightHit); },
+            surface.shape);
+        if (crossed) {
+          nearest = lightHit.t;
+          lamp = &surface.radiance;
+        }
+      }
+      if (lamp != nullptr) {
+        if (ctx.fog) fogSegment(nearest, depth);
+        radiance += throughput * *lamp;
+        break;
+      }
+    }
+    if (!found) {
       if (ctx.fog && scene.fog()->distance == FogDistance::Ray) {
         radiance += throughput * scene.fog()->color;
       } else if (ctx.uniformBackground) {
@@ -694,14 +731,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
       }
       break;
     }
-    if (ctx.fog) {
-      const Fog& fog = *scene.fog();
-      const bool viewDepth = fog.distance == FogDistance::Depth && depth == 0;
-      const double f =
-          fog.visibility(viewDepth ? hit.t * dot(ray.direction, scene.camera().toward()) : hit.t);
-      radiance += throughput * fog.color * (1 - f);
-      throughput *= f;
-    }
+    if (ctx.fog) fogSegment(hit.t, depth);
     // The hit's material, emission and shading normal, textures and vertex colours applied.
     TexturedHit textured;
     if (ctx.textured) {
@@ -765,6 +795,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
     Vec3 w;
     Color factor;
     brdfPdf = 0;
+    seesLights = pick >= diffuse + glossy;  // the specular lobes' rays see lights
     if (pick < diffuse + glossy) {
       const Point2 u = stream.get2D(kPathDirectionDimension);
       if (pick < diffuse) {

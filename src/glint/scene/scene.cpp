@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <variant>
 
 namespace glint {
 
@@ -104,6 +105,25 @@ Scene::Scene(SceneParts parts)
       emitterSampler_(render_.integrator == Integrator::Path
                           ? EmitterSampler::make(aggregate_.primitives(), aggregate_.meshes(),
                                                  materials_, materialTextures_)
-                          : nullptr) {}
+                          : nullptr) {
+  if (render_.integrator != Integrator::Path) return;
+  for (const Light& light : lights_) {
+    const auto* area = std::get_if<AreaLight>(&light);
+    if (area == nullptr) continue;
+    switch (area->shape) {
+      case AreaShape::Rectangle:
+        lightSurfaces_.push_back(
+            {Rectangle::make(area->corner, area->edge1, area->edge2), area->intensity});
+        break;
+      case AreaShape::Disk:
+        lightSurfaces_.push_back(
+            {Disk::make(area->center, area->normal, area->radius), area->intensity});
+        break;
+      case AreaShape::Sphere:
+        lightSurfaces_.push_back({Sphere::make(area->center, area->radius), area->intensity});
+        break;
+    }
+  }
+}
 
 }  // namespace glint

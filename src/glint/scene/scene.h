@@ -136,6 +136,13 @@ class Scene {
   // The emissive surfaces sampled as lights by the path integrator; null when there are none and
   // under the Whitted integrator.
   const EmitterSampler* emitterSampler() const { return emitterSampler_.get(); }
+  // Under the path integrator, the area lights as surfaces that camera and mirror rays see (their
+  // shape and its radiance, colour × intensity); empty otherwise.
+  struct LightSurface {
+    Shape shape;
+    Color radiance;
+  };
+  const std::vector<LightSurface>& lightSurfaces() const { return lightSurfaces_; }
   bool uniformBackground() const { return environment_.kind == BackgroundKind::Uniform; }
   // What a ray leaving the scene along the unit direction d sees.
   Color backgroundAlong(const Vec3& d) const { return environment_.along(d, background_); }
@@ -167,6 +174,7 @@ class Scene {
   RenderSettings render_;
   Aggregate aggregate_;
   std::shared_ptr<const EmitterSampler> emitterSampler_;  // after aggregate_: built from it
+  std::vector<LightSurface> lightSurfaces_;
 };
 
 }  // namespace glint
