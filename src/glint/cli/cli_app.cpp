@@ -232,11 +232,14 @@ std::string summaryText(const RenderJobResult& result) {
       stats.seconds > 0
           ? fmt::format("{:.2f} Mrays/s", static_cast<double>(rays.total()) / stats.seconds / 1e6)
           : std::string("- Mrays/s");
+  // The path integrator's diffuse and glossy bounces are a kind of their own.
+  const std::string indirect =
+      rays.indirect > 0 ? fmt::format(", {} indirect", rays.indirect) : std::string();
   std::string text = fmt::format(
       "glint: wrote {} ({}) in {}; rays: {} camera, {} shadow, {} reflection, "
-      "{} refraction; {}\n",
+      "{} refraction{}; {}\n",
       result.output.string(), regionText(scene, result.crop), formatDuration(stats.seconds),
-      rays.camera, rays.shadow, rays.reflection, rays.refraction, rate);
+      rays.camera, rays.shadow, rays.reflection, rays.refraction, indirect, rate);
   // Adaptive sampling spends a varying number of samples per pixel.
   if (scene.image.adaptive && result.pixelsRendered > 0)
     text +=

@@ -402,6 +402,7 @@ void Coordinator::render(const Scene& scene, const RenderOptions& options, Film&
     stats.rays.shadow += report.rays.shadow;
     stats.rays.reflection += report.rays.reflection;
     stats.rays.refraction += report.rays.refraction;
+    stats.rays.indirect += report.rays.indirect;
     stats.samples += report.samples;
     stats.nonFinite += report.nonFinite;
     if (report.firstNonFinite &&

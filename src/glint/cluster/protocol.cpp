@@ -70,6 +70,7 @@ void writeRays(Writer& w, const RayCounts& rays) {
   w.u64(rays.shadow);
   w.u64(rays.reflection);
   w.u64(rays.refraction);
+  w.u64(rays.indirect);
 }
 
 RayCounts readRays(Reader& r) {
@@ -78,6 +79,7 @@ RayCounts readRays(Reader& r) {
   rays.shadow = r.u64();
   rays.reflection = r.u64();
   rays.refraction = r.u64();
+  rays.indirect = r.u64();
   return rays;
 }
 

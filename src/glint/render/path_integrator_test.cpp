@@ -141,8 +141,9 @@ TEST(PathIntegrator, ClosedEmissiveSphereConvergesToTheGeometricSeries) {
   EXPECT_NEAR(mean.r / (emission.r / (1 - albedo)), 1, 0.01);
   EXPECT_NEAR(mean.g / (emission.g / (1 - albedo)), 1, 0.01);
   EXPECT_NEAR(mean.b / (emission.b / (1 - albedo)), 1, 0.01);
-  // Paths went on after the primary hit: indirect rays were traced and counted.
-  EXPECT_GT(stats.rays.reflection, stats.rays.camera);
+  // Paths went on after the primary hit: indirect rays were traced and counted as such.
+  EXPECT_GT(stats.rays.indirect, stats.rays.camera);
+  EXPECT_EQ(stats.rays.reflection, 0u);
 }
 
 TEST(PathIntegrator, TheSameBytesOnAnyThreadCountAndTileSize) {

@@ -813,7 +813,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
       }
       if (!(dot(n, w) * side > 0)) break;  // below the geometric surface
       if (ctx.environment != nullptr || ctx.emitters != nullptr) lobes.weighted(w, brdfPdf);
-      ++ctx.counts.reflection;
+      ++ctx.counts.indirect;
     } else if (pick < diffuse + glossy + mirror) {
       w = specularLobeDirection(reflected, material.reflectionBlur, n, stream);
       factor = material.kr * (total / mirror);
@@ -1215,7 +1215,8 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
   plan.drawsSamples = drawsSamples(scene, plan);
   const std::uint64_t seed = scene.render().seed;
 
-  std::atomic<std::uint64_t> cameraRays{0}, shadowRays{0}, reflectionRays{0}, refractionRays{0};
+  std::atomic<std::uint64_t> cameraRays{0}, shadowRays{0}, reflectionRays{0}, refractionRays{0},
+      indirectRays{0};
   std::atomic<std::uint64_t> pixelSamples{0};
   std::atomic<std::uint64_t> nonFinite{0};
   std::atomic<bool> cancelled{false};
@@ -1297,6 +1298,7 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
     shadowRays += counts.shadow;
     reflectionRays += counts.reflection;
     refractionRays += counts.refraction;
+    indirectRays += counts.indirect;
     if (abandoned) return;
     nonFinite += tileNonFinite;
     pixelSamples += tileSamples;
@@ -1344,6 +1346,7 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
     stats->rays.shadow = shadowRays.load();
     stats->rays.reflection = reflectionRays.load();
     stats->rays.refraction = refractionRays.load();
+    stats->rays.indirect = indirectRays.load();
     stats->nonFinite = nonFinite.load();
     stats->firstNonFinite = firstNonFinite;
     stats->tilesResumed = tilesResumed;

@@ -23,7 +23,8 @@ struct RayCounts {
   std::uint64_t shadow = 0;
   std::uint64_t reflection = 0;
   std::uint64_t refraction = 0;
-  std::uint64_t total() const { return camera + shadow + reflection + refraction; }
+  std::uint64_t indirect = 0;  // path integrator: the diffuse and glossy bounces
+  std::uint64_t total() const { return camera + shadow + reflection + refraction + indirect; }
 };
 
 // A pixel in full-image coordinates (row 0 at the top).
