@@ -490,18 +490,12 @@ ParseResult parse(std::string_view text, SceneDescription scene, const std::atom
 
 ParseResult parseNff(std::string_view text, const std::string& file,
                      const std::filesystem::path& baseDirectory, const std::atomic<bool>* cancel) {
-  SceneDescription scene = sceneWithFile(file, baseDirectory);
-  scene.files[0]->bytes = text.size();
-  return parse(text, std::move(scene), cancel);
+  return parseSceneText(text, file, baseDirectory, cancel, parse);
 }
 
 ParseResult readNffFile(const std::filesystem::path& path, const std::string& name,
                         const std::atomic<bool>* cancel) {
-  std::filesystem::path base = path.parent_path();
-  if (base.empty()) base = ".";
-  SceneDescription scene = sceneWithFile(name, base);
-  const std::string text = readWholeSceneFile(path, name, *scene.files[0]);
-  return parse(text, std::move(scene), cancel);
+  return readSceneTextFile(path, name, cancel, parse);
 }
 
 }  // namespace glint

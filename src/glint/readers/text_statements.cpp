@@ -197,6 +197,23 @@ SceneDescription sceneWithFile(const std::string& name, const std::filesystem::p
   return scene;
 }
 
+ParseResult parseSceneText(std::string_view text, const std::string& file,
+                           const std::filesystem::path& baseDirectory,
+                           const std::atomic<bool>* cancel, StatementReader read) {
+  SceneDescription scene = sceneWithFile(file, baseDirectory);
+  scene.files[0]->bytes = text.size();
+  return read(text, std::move(scene), cancel);
+}
+
+ParseResult readSceneTextFile(const std::filesystem::path& path, const std::string& name,
+                              const std::atomic<bool>* cancel, StatementReader read) {
+  std::filesystem::path base = path.parent_path();
+  if (base.empty()) base = ".";
+  SceneDescription scene = sceneWithFile(name, base);
+  const std::string text = readWholeSceneFile(path, name, *scene.files[0]);
+  return read(text, std::move(scene), cancel);
+}
+
 std::string nearestName(std::string_view word, const std::vector<std::string_view>& names) {
   return closestName(word, names);
 }

@@ -14,6 +14,7 @@
 #include "glint/readers/diagnostics.h"
 #include "glint/readers/scene_description.h"
 #include "glint/readers/value_tree.h"
+#include "glint/readers/yaml_scene_reader.h"
 
 namespace glint {
 
@@ -111,6 +112,17 @@ std::string readWholeSceneFile(const std::filesystem::path& path, const std::str
 
 // A scene with its one file, as readers begin.
 SceneDescription sceneWithFile(const std::string& name, const std::filesystem::path& base);
+
+// A text reader's statements over a scene that holds its one file.
+using StatementReader = ParseResult (*)(std::string_view text, SceneDescription scene,
+                                        const std::atomic<bool>* cancel);
+// The two entry points every text reader has: `text` in memory as the file `file` (relative paths
+// from `baseDirectory`), or the file at `path` shown as `name` (relative paths from its folder).
+ParseResult parseSceneText(std::string_view text, const std::string& file,
+                           const std::filesystem::path& baseDirectory,
+                           const std::atomic<bool>* cancel, StatementReader read);
+ParseResult readSceneTextFile(const std::filesystem::path& path, const std::string& name,
+                              const std::atomic<bool>* cancel, StatementReader read);
 
 // The closest of `names` to `word` for "did you mean" (case-insensitive), or "".
 std::string nearestName(std::string_view word, const std::vector<std::string_view>& names);
