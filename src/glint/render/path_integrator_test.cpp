@@ -387,5 +387,70 @@ TEST(PathIntegrator, AreaLightsAreSeenByCameraAndMirrorRays) {
   for (const Color& c : mirrored.pixels()) EXPECT_EQ(c, Color(1, 1.5, 2));
 }
 
+// Materials written for Whitted's model may reflect and transmit more than they receive (kd + kr
+// = 1.4 here): past the lights' direct term the path integrator scales the lobes to a sum of 1, so
+// a convex object under a uniform sky L renders exactly L (not 1.4·L, nor more with each bounce).
+TEST(PathIntegrator, ASurfaceNeverPassesOnMoreLightThanItReceives) {
+  const Color background(0.5, 0.7, 0.9);
+  SceneParts parts = cameraParts(16, 16);
+  parts.background = background;
+  parts.image.samples = 16;
+  Material bright = diffuse(Color(0.5, 0.5, 0.5));
+  bright.kr = Color(0.9, 0.9, 0.9);
+  parts.primitives.emplace_back(Sphere::make({0, 0, -5}, 10), addMaterial(parts, bright), Color{});
+  parts.camera.position = {0, 0, 30};
+  parts.camera.viewPlaneWidth = parts.camera.viewPlaneHeight = 0.2;
+  const Film film = render(Scene(std::move(parts)));
+  for (const Color& c : film.pixels()) {
+    EXPECT_NEAR(c.r, background.r, 1e-12);
+    EXPECT_NEAR(c.g, background.g, 1e-12);
+    EXPECT_NEAR(c.b, background.b, 1e-12);
+  }
+}
+
+// A diffuse floor under an area light behind a clear slab (kt 1, ior 1): the direct term already
+// carries the lamp's light through the slab (its shadow rays keep kt per crossing), so a diffuse
+// bounce that passes the slab must not find the lamp again. The path integrator gives the Whitted
+// integrator's image to the bit (the background is black and nothing else is lit), also for a
+// floor whose kd + ks is above 1 (its direct term is Whitted's, unscaled).
+TEST(PathIntegrator, AnAreaLightBehindClearGlassIsCountedOnce) {
+  for (const double ks : {0.0, 0.7}) {
+    const auto scene = [ks](Integrator integrator) {
+      SceneParts parts = cameraParts(12, 9);
+      parts.camera.direction = {0, -1, 0};  // looking down at the floor, away from the slab
+      parts.camera.up = {0, 0, -1};
+      parts.image.samples = 4;
+      parts.render.integrator = integrator;
+      Material floor = diffuse(Color(0.7, 0.6, 0.5));
+      floor.ks = Color(ks, ks, ks);
+      floor.shininess = 20;
+      parts.primitives.emplace_back(Plane::make({0, -1, 0}, {0, 1, 0}), addMaterial(parts, floor),
+                                    Color{});
+      Material clear;
+      clear.kt = Color(1, 1, 1);
+      parts.primitives.emplace_back(Box::make({-50, 1, -50}, {50, 1.1, 50}),
+                                    addMaterial(parts, clear), Color{});
+      AreaLight lamp;
+      lamp.shape = AreaShape::Rectangle;
+      lamp.corner = {-2, 3, -2};
+      lamp.edge1 = {4, 0, 0};
+      lamp.edge2 = {0, 0, 4};
+      lamp.intensity = Color(1.5, 1.5, 1.5);
+      lamp.samples = 4;
+      parts.lights.push_back(lamp);
+      return Scene(std::move(parts));
+    };
+    const Film whitted = render(scene(Integrator::Whitted));
+    const Film path = render(scene(Integrator::Path));
+    ASSERT_EQ(whitted.pixels().size(), path.pixels().size());
+    double lit = 0;
+    for (std::size_t k = 0; k < whitted.pixels().size(); ++k) {
+      EXPECT_EQ(whitted.pixels()[k], path.pixels()[k]) << "ks " << ks << " pixel " << k;
+      lit += whitted.pixels()[k].r;
+    }
+    EXPECT_GT(lit, 0) << "the lamp lights nothing";
+  }
+}
+
 }  // namespace
 }  // namespace glint

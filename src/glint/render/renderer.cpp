@@ -506,6 +506,9 @@ Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double
 //     point, spot and directional lights are delta lights, area lights keep their `samples`
 //     points with Whitted's falloff), so switching integrators never changes direct lighting;
 //   - the ambient light is not added (the background and the surfaces light the scene);
+//   - after that direct term, a material whose kd + ks + kr + kt exceeds 1 in a channel has the
+//     four scaled down together to a sum of 1 there (energy conservation for the indirect light
+//     and the sky and emitter samples);
 //   - the path goes on along one lobe chosen with probability proportional to its strength
 //     (largest component of kd, ks, kr, kt): kd by cosine-weighted sampling (f = kd/π, estimator
 //     kd), ks by sampling the normalised modified Phong lobe about the mirror direction
@@ -514,9 +517,10 @@ Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double
 //   - from render.min_depth hits on, Russian roulette ends the path with probability
 //     1 − min(1, max component of its throughput) and divides the survivors by the rest;
 //   - fog, linear in what lies behind it, fades each segment: L += T·(1 − f)·fog; T *= f;
-//   - camera rays and the rays of the kr/kt lobes see the area lights as surfaces of radiance
-//     colour × intensity (Scene::lightSurfaces) and end there; the kd/ks lobes' rays pass them
-//     (their light is in the direct term), and so do all shadow rays (as under Whitted).
+//   - camera rays and the rays of kr/kt lobes reached from the camera by kr/kt lobes only see the
+//     area lights as surfaces of radiance colour × intensity (Scene::lightSurfaces) and end there;
+//     once a path has taken a kd or ks lobe its rays pass them (their light, through glass too,
+//     is in every later hit's direct term), and so do all shadow rays (as under Whitted).
 // Sample dimensions at each hit (the stream of the path there): 2 the lobe direction, 3 the lobe
 // choice (x) and the roulette (y), 4 + i area light i as in Whitted's, 2^30 + 1 the environment
 // direction; the next hit's stream is branch(2, 1, 0). The same bytes on any thread count, crop and
@@ -682,8 +686,8 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
   // importance sampling where it meets the image environment; 0 for camera rays and specular
   // lobes, which the environment's samples never stand in for.
   double brdfPdf = 0;
-  // Camera rays and the rays of specular lobes see the area lights (Scene::lightSurfaces); the
-  // diffuse and glossy lobes' rays do not (the lights' direct term already counts their light).
+  // Camera rays and specular chains from them see the area lights (Scene::lightSurfaces); paths
+  // past a diffuse or glossy lobe do not (the lights' direct term already counts their light).
   bool seesLights = true;
   // Fog over a segment of length t (scene units) of the path at `depth`: what lies behind fades.
   const auto fogSegment = [&](double t, int depth) {
@@ -770,6 +774,19 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
                     stream, false);
     if (depth + 1 >= ctx.maxDepth) break;
 
+    // Past the lights' direct term a surface passes on at most the light it receives: materials
+    // written for Whitted's model often have kd + ks + kr + kt above 1 (ks there is only the
+    // lights' highlight), which would make every bounce add light and glass glow. Their lobes
+    // are scaled down together to a sum of 1 in the strongest channel.
+    const double lobeSum = maxComponent(material.kd + material.ks + material.kr + material.kt);
+    if (lobeSum > 1) {
+      const double conserve = 1 / lobeSum;
+      material.kd *= conserve;
+      material.ks *= conserve;
+      material.kr *= conserve;
+      material.kt *= conserve;
+    }
+
     // One lobe, chosen by strength.
     const double diffuse = maxComponent(material.kd);
     const double glossy = maxComponent(material.ks);
@@ -795,7 +812,10 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
     Vec3 w;
     Color factor;
     brdfPdf = 0;
-    seesLights = pick >= diffuse + glossy;  // the specular lobes' rays see lights
+    // Only specular chains from the camera see the area lights: after a diffuse or glossy bounce
+    // their light is in that hit's direct term, shadow rays through glass included (a kt chain
+    // reaching a lamp would count it twice, and as fireflies).
+    seesLights = seesLights && pick >= diffuse + glossy;
     if (pick < diffuse + glossy) {
       const Point2 u = stream.get2D(kPathDirectionDimension);
       if (pick < diffuse) {
