@@ -88,25 +88,18 @@ TEST_F(Cli, ArgumentParserErrorsExitTwo) {
 }
 
 TEST_F(Cli, OutOfRangeOptionsExitTwoBeforeRendering) {
-  const std::vector<std::vector<std::string>> cases{{"--samples", "0"},
-                                                    {"--samples", "65537"},
-                                                    {"--threads", "0"},
-                                                    {"--threads", "-3"},
-                                                    {"--width", "0"},
-                                                    {"--height", "-1"},
-                                                    {"--width", "70000"},
-                                                    {"--height", "65536"},
-                                                    {"--width", "65535"},
-                                                    {"--seed", "-1"},
-                                                    {"--crop", "0,0,33,24"},
-                                                    {"--crop", "0,0,32,25"},
-                                                    {"--crop", "5,0,5,24"},
-                                                    {"--crop", "0,10,32,4"},
-                                                    {"--crop", "-1,0,8,8"},
-                                                    {"--crop", "1,2,3"},
-                                                    {"--crop", "a,b,c,d"},
-                                                    {"--crop", "0,0,8,8,9"},
-                                                    {"--crop", "0,0,40,30", "--width", "32"}};
+  const std::vector<std::vector<std::string>> cases{
+      {"--samples", "0"},        {"--samples", "65537"},
+      {"--threads", "0"},        {"--threads", "-3"},
+      {"--width", "0"},          {"--height", "-1"},
+      {"--width", "70000"},      {"--height", "65536"},
+      {"--width", "65535"},      {"--seed", "-1"},
+      {"--integrator", "bidir"}, {"--crop", "0,0,33,24"},
+      {"--crop", "0,0,32,25"},   {"--crop", "5,0,5,24"},
+      {"--crop", "0,10,32,4"},   {"--crop", "-1,0,8,8"},
+      {"--crop", "1,2,3"},       {"--crop", "a,b,c,d"},
+      {"--crop", "0,0,8,8,9"},   {"--crop", "0,0,40,30", "--width", "32"},
+  };
   for (const auto& extra : cases) {
     std::vector<std::string> args{"render", small(), "-o", "out.png"};
     args.insert(args.end(), extra.begin(), extra.end());
@@ -457,6 +450,23 @@ TEST_F(Cli, SeedReplacesTheScenesSeed) {
   EXPECT_FALSE(scene == readFile(work_ / "eight.ppm"));
 }
 
+TEST_F(Cli, IntegratorReplacesTheScenesIntegrator) {
+  // small.yaml renders with Whitted's model (it names no integrator); --integrator whitted keeps
+  // the bytes, --integrator path changes them (no ambient term, indirect light) and says so.
+  ASSERT_EQ(run({"render", small(), "-o", "scene.ppm", "--quiet"}).status, 0);
+  ASSERT_EQ(
+      run({"render", small(), "-o", "whitted.ppm", "--quiet", "--integrator", "whitted"}).status,
+      0);
+  const RunResult path =
+      run({"render", small(), "-o", "path.ppm", "--stats", "--integrator", "path"});
+  ASSERT_EQ(path.status, 0) << path.err;
+  EXPECT_TRUE(contains(path.err, "path integrator")) << path.err;
+  EXPECT_TRUE(contains(path.err, " indirect")) << path.err;
+  const std::string scene = readFile(work_ / "scene.ppm");
+  EXPECT_TRUE(scene == readFile(work_ / "whitted.ppm"));
+  EXPECT_FALSE(scene == readFile(work_ / "path.ppm"));
+}
+
 TEST_F(Cli, SamplesOverrideChangesTheImage) {
   ASSERT_EQ(run({"render", small(), "-o", "four.ppm", "--quiet"}).status, 0);
   ASSERT_EQ(run({"render", small(), "-o", "one.ppm", "--quiet", "--samples", "1"}).status, 0);
@@ -741,6 +751,7 @@ TEST_F(CliCheckpoint, ResumeRefusesAMismatchedCorruptOrMissingCheckpoint) {
           "cannot resume from 'run.ckpt': it was made with samples per "
           "pixel 4, this render has 2");
   refused({"--seed", "8"}, "it was made with seed 7, this render has 8");
+  refused({"--integrator", "path"}, "it was made with integrator whitted, this render has path");
   refused({"--crop", "0,0,80,60"}, "region the whole image, this render has --crop 0,0,80,60");
   EXPECT_EQ(readFile(work_ / "run.ckpt"), checkpoint) << "a refused resume keeps the checkpoint";
 

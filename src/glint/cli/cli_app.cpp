@@ -75,7 +75,7 @@ void printError(std::string_view message) {
 struct RenderArgs {
   std::string scene;
   std::string output;
-  std::optional<std::string> width, height, samples, threads, seed, crop, maxMemory;
+  std::optional<std::string> width, height, samples, threads, seed, crop, maxMemory, integrator;
   std::optional<std::string> checkpoint, resume;  // checkpoint files
   bool quiet = false;
   bool stats = false;
@@ -191,6 +191,10 @@ std::string boundsText(const SceneFacts& scene) {
   return fmt::format("{} to {}", formatPoint(scene.bounds.lo), formatPoint(scene.bounds.hi));
 }
 
+std::string_view integratorName(Integrator integrator) {
+  return integrator == Integrator::Path ? "path" : "whitted";
+}
+
 // "3 (1 area) + ambient": the light sources, how many of them are area lights (soft shadows), and
 // whether the scene has ambient light.
 std::string lightsText(const SceneFacts& scene) {
@@ -276,10 +280,10 @@ void printStats(const RenderJobResult& result, int threads) {
       scene.objects, scene.objects - scene.unboundedObjects, scene.unboundedObjects,
       scene.materials, lightsText(scene));
   text += fmt::format("glint: bounds: {}\n", boundsText(scene));
-  text += fmt::format("glint: image: {}, {}, {} {}, max depth {}, seed {}\n",
+  text += fmt::format("glint: image: {}, {}, {} {}, {} integrator, max depth {}, seed {}\n",
                       regionText(scene, result.crop), samplesText(scene), threads,
                       plural(static_cast<std::uint64_t>(threads), "thread", "threads"),
-                      scene.maxDepth, scene.seed);
+                      integratorName(scene.integrator), scene.maxDepth, scene.seed);
   text += fmt::format("glint: rays: {} total, {:.1f} per pixel\n", stats.rays.total(),
                       static_cast<double>(stats.rays.total()) / pixels);
   text += fmt::format("glint: samples: {} total, {:.2f} per pixel\n", stats.samples,
@@ -374,6 +378,16 @@ RenderJobSpec parseRequest(const RenderArgs& args) {
     named.push_back("--samples " + *args.samples);
   }
   if (args.seed) spec.overrides.seed = parseSeed(*args.seed);
+  if (args.integrator) {
+    if (*args.integrator == "whitted") {
+      spec.overrides.integrator = Integrator::Whitted;
+    } else if (*args.integrator == "path") {
+      spec.overrides.integrator = Integrator::Path;
+    } else {
+      throw CliError(kExitBadInput, fmt::format("--integrator expects whitted or path, got '{}'",
+                                                *args.integrator));
+    }
+  }
   if (args.threads)
     spec.threads = static_cast<int>(parseWholeNumber("--threads", *args.threads, 1, kMaxThreads));
   if (args.crop) spec.crop = parseCrop(*args.crop);
@@ -517,7 +531,7 @@ int runCommandLine(int argc, char** argv) {
                    "default: the scene's name with .png, in the current folder")
       ->type_name("OUT");
   // Valued options are read as text and parsed by parseRequest (uniform messages, no wrap-around).
-  std::string width, height, samples, threads, seed, crop;
+  std::string width, height, samples, threads, seed, crop, integrator;
   CLI::Option* widthOption =
       render->add_option("--width", width, "Image width in pixels; alone it keeps the aspect")
           ->type_name("W");
@@ -532,6 +546,11 @@ int runCommandLine(int argc, char** argv) {
   CLI::Option* seedOption =
       render->add_option("--seed", seed, "Random seed (replaces the scene's render.seed)")
           ->type_name("S");
+  CLI::Option* integratorOption =
+      render
+          ->add_option("--integrator", integrator,
+                       "whitted or path (replaces the scene's render.integrator)")
+          ->type_name("NAME");
   CLI::Option* cropOption =
       render
           ->add_option("--crop", crop,
@@ -620,6 +639,7 @@ int runCommandLine(int argc, char** argv) {
   args.threads = given(threadsOption, threads);
   args.seed = given(seedOption, seed);
   args.crop = given(cropOption, crop);
+  args.integrator = given(integratorOption, integrator);
   args.maxMemory = given(maxMemoryOption, maxMemory);
   args.checkpoint = given(checkpointOption, checkpoint);
   args.resume = given(resumeOption, resume);

@@ -16,6 +16,7 @@ class Writer {
     u64(s.size());
     bytes_.append(s);
   }
+  void raw(std::string_view s) { bytes_.append(s); }  // fixed-size bytes, no length
   void reserve(std::size_t n) { bytes_.reserve(n); }
   std::string take() { return std::move(bytes_); }
 
@@ -39,6 +40,12 @@ class Reader {
     std::string s(bytes_.substr(at_, static_cast<std::size_t>(size)));
     at_ += static_cast<std::size_t>(size);
     return s;
+  }
+  std::string_view raw(std::size_t size) {
+    need(size);
+    const std::string_view part = bytes_.substr(at_, size);
+    at_ += size;
+    return part;
   }
   std::size_t left() const { return bytes_.size() - at_; }
   void end() const {
@@ -96,18 +103,7 @@ std::string encodeIdentity(const RankIdentity& identity) {
   w.u64(identity.sceneHash);
   w.u64(identity.meshCount);
   w.u64(identity.meshHash);
-  const CheckpointSettings& s = identity.settings;
-  w.i32(s.width);
-  w.i32(s.height);
-  w.i32(s.samples);
-  w.i32(s.adaptiveMaxSamples);
-  w.f64(s.adaptiveThreshold);
-  w.u64(s.seed);
-  w.i32(s.region.x0);
-  w.i32(s.region.y0);
-  w.i32(s.region.x1);
-  w.i32(s.region.y1);
-  w.i32(s.tileSize);
+  w.raw(encodeCheckpointSettings(identity.settings));
   w.u64(identity.fingerprint);
   w.text(identity.error);
   return w.take();
@@ -127,18 +123,11 @@ RankIdentity decodeIdentity(std::string_view bytes) {
   identity.sceneHash = r.u64();
   identity.meshCount = r.u64();
   identity.meshHash = r.u64();
-  CheckpointSettings& s = identity.settings;
-  s.width = r.i32();
-  s.height = r.i32();
-  s.samples = r.i32();
-  s.adaptiveMaxSamples = r.i32();
-  s.adaptiveThreshold = r.f64();
-  s.seed = r.u64();
-  s.region.x0 = r.i32();
-  s.region.y0 = r.i32();
-  s.region.x1 = r.i32();
-  s.region.y1 = r.i32();
-  s.tileSize = r.i32();
+  try {
+    identity.settings = decodeCheckpointSettings(r.raw(kCheckpointSettingsBytes));
+  } catch (const std::invalid_argument&) {
+    throw ProtocolError("a malformed Hello message");
+  }
   identity.fingerprint = r.u64();
   identity.error = r.text();
   r.end();

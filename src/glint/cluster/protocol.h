@@ -34,7 +34,7 @@ enum class Tag : int {
 };
 
 // Bumped whenever a layout below changes; ranks of other versions are refused by the Hello check.
-inline constexpr std::uint32_t kProtocolVersion = 1;
+inline constexpr std::uint32_t kProtocolVersion = 2;
 
 // A payload that does not decode: a bug or a rank of another build.
 class ProtocolError : public std::runtime_error {

@@ -24,8 +24,8 @@ RankIdentity sampleIdentity() {
   identity.sceneHash = 0x0123456789abcdefull;
   identity.meshCount = 2;
   identity.meshHash = 0xfedcba9876543210ull;
-  identity.settings =
-      CheckpointSettings{640, 480, 4, 64, 0.05, 99, PixelRegion{1, 2, 300, 400}, 16};
+  identity.settings = CheckpointSettings{
+      640, 480, 4, 64, 0.05, 99, PixelRegion{1, 2, 300, 400}, 16, Integrator::Path};
   identity.fingerprint = 42;
   return identity;
 }

@@ -71,7 +71,7 @@ class Builder {
       sink_.error({main.name, 1, 1}, "the scene is missing required key 'image'");
     }
     if (const Entity* render = d_.first(EntityKind::RenderEntity)) buildRender(d_, *render, ctx_);
-    if (options_.overrides.seed) parts_.render.seed = *options_.overrides.seed;
+    applyRenderOverrides(parts_.render, options_.overrides);
     for (const Entity& e : d_.entities) {
       if (e.kind == EntityKind::TextureEntity) textures_.buildNamed(e);
     }

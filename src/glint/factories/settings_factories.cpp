@@ -148,7 +148,6 @@ void buildImage(const SceneDescription& scene, const Entity& e, BuildContext& ct
 
 void buildRender(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
   RenderSettings& render = ctx.parts.render;
-  if (ctx.options.overrides.seed) render.seed = *ctx.options.overrides.seed;
   auto params = sectionParameters(scene, e, ctx, "a mapping of render settings", "render");
   if (!params) return;
   ParameterDictionary& p = *params;
@@ -192,7 +191,6 @@ void buildRender(const SceneDescription& scene, const Entity& e, BuildContext& c
     render.blurSamples = static_cast<int>(*v);
   }
   if (const auto v = p.unsignedInteger("seed")) render.seed = v->value;
-  if (ctx.options.overrides.seed) render.seed = *ctx.options.overrides.seed;
   p.finish();
 }
 

@@ -22,7 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // Bytes before the tile bitmap: magic, version, reserved, fingerprint, settings, tile count.
-constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 + (4 * 4 + 8 + 8 + 5 * 4) + 8;
+constexpr std::size_t kHeaderBytes = 8 + 4 + 4 + 8 + kCheckpointSettingsBytes + 8;
 constexpr std::size_t kPixelBytes = 3 * 8;
 // Tiles of at most this many pixels per side; more is not a file glint wrote.
 constexpr std::int64_t kMaxTileSize = 65535;
@@ -139,6 +139,7 @@ CheckpointSettings checkpointSettingsFor(const Scene& scene, const PixelRegion& 
   s.seed = scene.render().seed;
   s.region = region;
   s.tileSize = tileSize;
+  s.integrator = scene.render().integrator;
   return s;
 }
 
@@ -180,19 +181,49 @@ std::uint64_t renderFingerprint(std::string_view sceneFileBytes, const Scene& sc
     }
     hash = hashVector(images[i]->pixels(0), hash);
   }
-  Writer s;
-  s.i32(settings.width);
-  s.i32(settings.height);
-  s.i32(settings.samples);
-  s.i32(settings.adaptiveMaxSamples);
-  s.f64(settings.adaptiveThreshold);
-  s.u64(settings.seed);
-  s.i32(settings.region.x0);
-  s.i32(settings.region.y0);
-  s.i32(settings.region.x1);
-  s.i32(settings.region.y1);
-  s.i32(settings.tileSize);
-  return fnv1a64(s.text(), hash);
+  return fnv1a64(encodeCheckpointSettings(settings), hash);
+}
+
+std::string encodeCheckpointSettings(const CheckpointSettings& settings) {
+  Writer w;
+  w.i32(settings.width);
+  w.i32(settings.height);
+  w.i32(settings.samples);
+  w.i32(settings.adaptiveMaxSamples);
+  w.f64(settings.adaptiveThreshold);
+  w.u64(settings.seed);
+  w.i32(settings.region.x0);
+  w.i32(settings.region.y0);
+  w.i32(settings.region.x1);
+  w.i32(settings.region.y1);
+  w.i32(settings.tileSize);
+  w.i32(settings.integrator == Integrator::Path ? 1 : 0);
+  return std::move(w.text());
+}
+
+CheckpointSettings decodeCheckpointSettings(std::string_view bytes) {
+  if (bytes.size() != kCheckpointSettingsBytes)
+    throw std::invalid_argument(fmt::format("render settings of {} bytes, expected {}",
+                                            bytes.size(), kCheckpointSettingsBytes));
+  const std::string name;
+  Reader r(bytes, name);
+  CheckpointSettings s;
+  s.width = r.i32();
+  s.height = r.i32();
+  s.samples = r.i32();
+  s.adaptiveMaxSamples = r.i32();
+  s.adaptiveThreshold = r.f64();
+  s.seed = r.u64();
+  s.region.x0 = r.i32();
+  s.region.y0 = r.i32();
+  s.region.x1 = r.i32();
+  s.region.y1 = r.i32();
+  s.tileSize = r.i32();
+  const int integrator = r.i32();
+  if (integrator != 0 && integrator != 1)
+    throw std::invalid_argument(fmt::format("unknown integrator number {}", integrator));
+  s.integrator = integrator == 1 ? Integrator::Path : Integrator::Whitted;
+  return s;
 }
 
 std::size_t Checkpoint::finishedTiles() const {
@@ -220,17 +251,7 @@ std::string encodeCheckpoint(const Checkpoint& checkpoint) {
   w.u32(kCheckpointVersion);
   w.u32(0);
   w.u64(checkpoint.fingerprint);
-  w.i32(s.width);
-  w.i32(s.height);
-  w.i32(s.samples);
-  w.i32(s.adaptiveMaxSamples);
-  w.f64(s.adaptiveThreshold);
-  w.u64(s.seed);
-  w.i32(s.region.x0);
-  w.i32(s.region.y0);
-  w.i32(s.region.x1);
-  w.i32(s.region.y1);
-  w.i32(s.tileSize);
+  w.bytes(encodeCheckpointSettings(s));
   w.u64(tiles.size());
   std::string bitmap((tiles.size() + 7) / 8, '\0');
   for (std::size_t i = 0; i < tiles.size(); ++i)
@@ -283,18 +304,12 @@ Checkpoint decodeCheckpoint(std::string_view bytes, const std::string& name,
   r.u32();  // reserved
   Checkpoint checkpoint;
   checkpoint.fingerprint = r.u64();
-  CheckpointSettings& s = checkpoint.settings;
-  s.width = r.i32();
-  s.height = r.i32();
-  s.samples = r.i32();
-  s.adaptiveMaxSamples = r.i32();
-  s.adaptiveThreshold = r.f64();
-  s.seed = r.u64();
-  s.region.x0 = r.i32();
-  s.region.y0 = r.i32();
-  s.region.x1 = r.i32();
-  s.region.y1 = r.i32();
-  s.tileSize = r.i32();
+  try {
+    checkpoint.settings = decodeCheckpointSettings(r.bytes(kCheckpointSettingsBytes));
+  } catch (const std::invalid_argument& error) {
+    throw corrupt(error.what());
+  }
+  const CheckpointSettings& s = checkpoint.settings;
   const PixelRegion& region = s.region;
   if (s.width < 1 || s.width > 65535 || s.height < 1 || s.height > 65535 || region.x0 < 0 ||
       region.x0 >= region.x1 || region.x1 > s.width || region.y0 < 0 || region.y0 >= region.y1 ||
@@ -363,11 +378,16 @@ std::optional<std::uint64_t> checkpointSizeLimit(std::string_view header) {
   if (r.u32() != kCheckpointVersion) return std::nullopt;
   r.u32();  // reserved
   r.u64();  // fingerprint
-  const int width = r.i32();
-  const int height = r.i32();
-  r.bytes(4 + 4 + 8 + 8);  // samples, adaptive maximum and threshold, seed
-  const PixelRegion region{r.i32(), r.i32(), r.i32(), r.i32()};
-  const int tileSize = r.i32();
+  CheckpointSettings settings;
+  try {
+    settings = decodeCheckpointSettings(r.bytes(kCheckpointSettingsBytes));
+  } catch (const std::invalid_argument&) {
+    return std::nullopt;
+  }
+  const int width = settings.width;
+  const int height = settings.height;
+  const PixelRegion& region = settings.region;
+  const int tileSize = settings.tileSize;
   const std::uint64_t tileCount = r.u64();
   if (width < 1 || height < 1 || region.x0 < 0 || region.x0 >= region.x1 || region.x1 > width ||
       region.y0 < 0 || region.y0 >= region.y1 || region.y1 > height || tileSize < 1 ||
@@ -476,6 +496,10 @@ std::optional<SettingDifference> firstSettingDifference(const CheckpointSettings
     return SettingDifference{"seed", std::to_string(a.seed), std::to_string(b.seed)};
   if (a.tileSize != b.tileSize)
     return SettingDifference{"tile size", std::to_string(a.tileSize), std::to_string(b.tileSize)};
+  if (a.integrator != b.integrator) {
+    const auto name = [](Integrator i) { return i == Integrator::Path ? "path" : "whitted"; };
+    return SettingDifference{"integrator", name(a.integrator), name(b.integrator)};
+  }
   return std::nullopt;
 }
 

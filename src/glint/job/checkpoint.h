@@ -20,7 +20,7 @@
 namespace glint {
 
 // Bumped whenever the layout below changes; a file of another version is refused.
-inline constexpr std::uint32_t kCheckpointVersion = 1;
+inline constexpr std::uint32_t kCheckpointVersion = 2;
 // The first 8 bytes of every checkpoint file.
 inline constexpr std::string_view kCheckpointMagic{"GLINTCKP", 8};
 
@@ -35,11 +35,23 @@ struct CheckpointSettings {
   int samples = 0;             // image.samples (the minimum, with adaptive sampling)
   int adaptiveMaxSamples = 0;  // image.adaptive.max_samples; 0: fixed sampling
   double adaptiveThreshold = 0;
-  std::uint64_t seed = 0;  // render.seed
-  PixelRegion region;      // the crop, or the whole image
-  int tileSize = 0;        // pixels per tile side (RenderOptions::tileSize)
+  std::uint64_t seed = 0;                       // render.seed
+  PixelRegion region;                           // the crop, or the whole image
+  int tileSize = 0;                             // pixels per tile side (RenderOptions::tileSize)
+  Integrator integrator = Integrator::Whitted;  // render.integrator or --integrator
   friend bool operator==(const CheckpointSettings&, const CheckpointSettings&) = default;
 };
+
+// CheckpointSettings as bytes, one layout for the checkpoint file, the render fingerprint and the
+// MPI ranks' handshake (all integers little-endian, doubles as their IEEE-754 bits):
+//   i32 width, i32 height, i32 samples, i32 adaptiveMaxSamples, f64 adaptiveThreshold, u64 seed,
+//   i32 x0, i32 y0, i32 x1, i32 y1, i32 tileSize, i32 integrator (0 whitted, 1 path).
+inline constexpr std::size_t kCheckpointSettingsBytes = 4 * 4 + 8 + 8 + 5 * 4 + 4;
+std::string encodeCheckpointSettings(const CheckpointSettings& settings);
+// Reads exactly kCheckpointSettingsBytes bytes (std::invalid_argument for another size). Values
+// are not checked here except the integrator's (std::invalid_argument for an unknown one): each
+// reader checks them against what it holds.
+CheckpointSettings decodeCheckpointSettings(std::string_view bytes);
 
 // The settings of rendering `scene` over `region` in tiles of `tileSize`.
 CheckpointSettings checkpointSettingsFor(const Scene& scene, const PixelRegion& region,
@@ -80,10 +92,9 @@ struct Checkpoint {
 // An empty checkpoint (no tile finished) for a render with these settings.
 Checkpoint emptyCheckpoint(std::uint64_t fingerprint, const CheckpointSettings& settings);
 
-// File format, version 1; all integers little-endian, doubles as their IEEE-754 bits:
+// File format, version 2; all integers little-endian, doubles as their IEEE-754 bits:
 //   magic "GLINTCKP" | u32 version | u32 0 (reserved) | u64 fingerprint |
-//   settings: i32 width, i32 height, i32 samples, i32 adaptiveMaxSamples, f64 adaptiveThreshold,
-//             u64 seed, i32 x0, i32 y0, i32 x1, i32 y1, i32 tileSize |
+//   settings (encodeCheckpointSettings) |
 //   u64 tile count | tile bitmap, ceil(count / 8) bytes, tile i in bit (i % 8) of byte i / 8 |
 //   for each finished tile in index order, its pixels row by row: f64 r, g, b |
 //   u64 FNV-1a 64 of every byte before it.

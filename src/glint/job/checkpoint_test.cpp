@@ -34,6 +34,7 @@ CheckpointSettings sampleSettings() {
   s.seed = 0xfedcba9876543210ull;
   s.region = PixelRegion{10, 5, 30, 18};
   s.tileSize = 8;
+  s.integrator = Integrator::Path;
   return s;
 }
 
@@ -99,7 +100,7 @@ TEST(Checkpoint, LayoutHasTheDocumentedSize) {
   const std::string bytes = encodeCheckpoint(c);
   // Finished tiles 0 (8x8), 2 (4x8: x 26..30) and 5 (4x5: x 26..30, y 13..18).
   const std::size_t pixels = 64 + 32 + 20;
-  const std::size_t header = 8 + 4 + 4 + 8 + 4 * 4 + 8 + 8 + 5 * 4 + 8;
+  const std::size_t header = 8 + 4 + 4 + 8 + 4 * 4 + 8 + 8 + 5 * 4 + 4 + 8;
   EXPECT_EQ(bytes.size(), header + 1 + pixels * 24 + 8);
   EXPECT_EQ(bytes.substr(0, 8), "GLINTCKP");
   EXPECT_EQ(bytes[8], static_cast<char>(kCheckpointVersion));
@@ -188,6 +189,8 @@ TEST(Checkpoint, MismatchNamesTheSettingThatDiffers) {
             "off");
   EXPECT_EQ(message([](CheckpointSettings& s) { s.tileSize = 16; }),
             "it was made with tile size 8, this render has 16");
+  EXPECT_EQ(message([](CheckpointSettings& s) { s.integrator = Integrator::Whitted; }),
+            "it was made with integrator path, this render has whitted");
   const std::optional<std::string> scene = checkpointMismatch(c, c.fingerprint + 1, c.settings);
   ASSERT_TRUE(scene.has_value());
   EXPECT_NE(scene->find("scene file"), std::string::npos) << *scene;
@@ -228,6 +231,19 @@ TEST(Checkpoint, FingerprintCoversSceneBytesMeshesAndEverySetting) {
   EXPECT_NE(base, changed([](CheckpointSettings& t) { t.seed ^= 1; }));
   EXPECT_NE(base, changed([](CheckpointSettings& t) { t.region.x1 = 31; }));
   EXPECT_NE(base, changed([](CheckpointSettings& t) { t.tileSize = 9; }));
+  EXPECT_NE(base, changed([](CheckpointSettings& t) { t.integrator = Integrator::Whitted; }));
+}
+
+// The settings' bytes are shared by the file, the fingerprint and the MPI handshake: every field
+// survives, and a number that names no integrator is refused rather than read as one.
+TEST(Checkpoint, SettingsBytesRoundTripAndRefuseAnUnknownIntegrator) {
+  const CheckpointSettings s = sampleSettings();
+  std::string bytes = encodeCheckpointSettings(s);
+  ASSERT_EQ(bytes.size(), kCheckpointSettingsBytes);
+  EXPECT_EQ(decodeCheckpointSettings(bytes), s);
+  EXPECT_THROW(decodeCheckpointSettings(bytes.substr(1)), std::invalid_argument);
+  bytes[kCheckpointSettingsBytes - 4] = 2;  // the integrator, little-endian i32
+  EXPECT_THROW(decodeCheckpointSettings(bytes), std::invalid_argument);
 }
 
 TEST_F(CheckpointFile, WriteIsAtomicAndReplacesTheOldFile) {
@@ -324,7 +340,7 @@ TEST(Checkpoint, TheHeaderBoundsTheFileSize) {
   const Checkpoint c = sampleCheckpoint();
   const std::string bytes = encodeCheckpoint(c);
   // Header, bitmap (1 byte for 6 tiles), every pixel of the 20 x 13 region, checksum.
-  const std::size_t header = 8 + 4 + 4 + 8 + 4 * 4 + 8 + 8 + 5 * 4 + 8;
+  const std::size_t header = 8 + 4 + 4 + 8 + 4 * 4 + 8 + 8 + 5 * 4 + 4 + 8;
   EXPECT_EQ(checkpointSizeLimit(bytes), header + 1 + 20 * 13 * 24 + 8);
   EXPECT_GE(*checkpointSizeLimit(bytes), bytes.size());
   EXPECT_EQ(checkpointSizeLimit(bytes.substr(0, header - 1)), std::nullopt);

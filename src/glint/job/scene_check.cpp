@@ -105,6 +105,7 @@ SceneFacts sceneFacts(const Scene& scene) {
   facts.bounds = scene.aggregate().bounds();
   facts.maxDepth = scene.render().maxDepth;
   facts.seed = scene.render().seed;
+  facts.integrator = scene.render().integrator;
   return facts;
 }
 

@@ -35,6 +35,7 @@ struct SceneFacts {
   Bounds3 bounds;              // of the bounded objects; empty when there are none
   int maxDepth = 0;            // render.max_depth
   std::uint64_t seed = 0;      // render.seed
+  Integrator integrator = Integrator::Whitted;  // render.integrator, after --integrator
 };
 
 SceneFacts sceneFacts(const Scene& scene);

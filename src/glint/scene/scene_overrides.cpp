@@ -38,9 +38,14 @@ void applyImageOverrides(ImageSettings& image, const SceneOverrides& overrides) 
     image.adaptive->maxSamples = image.samples;
 }
 
+void applyRenderOverrides(RenderSettings& render, const SceneOverrides& overrides) {
+  if (overrides.seed) render.seed = *overrides.seed;
+  if (overrides.integrator) render.integrator = *overrides.integrator;
+}
+
 void applyOverrides(SceneParts& parts, const SceneOverrides& overrides) {
   applyImageOverrides(parts.image, overrides);
-  if (overrides.seed) parts.render.seed = *overrides.seed;
+  applyRenderOverrides(parts.render, overrides);
 }
 
 }  // namespace glint

@@ -1,6 +1,6 @@
 // Overrides of a loaded scene's image and render settings by its caller (the command line's
-// --width/--height/--samples/--seed, DESIGN.md §6), applied to SceneParts before the Scene is
-// built.
+// --width/--height/--samples/--seed, DESIGN.md §6, and --integrator), applied to SceneParts before
+// the Scene is built.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +20,8 @@ struct SceneOverrides {
   std::optional<int> width;    // pixels; given alone, the height follows the scene's aspect ratio
   std::optional<int> height;   // pixels; given alone, the width follows the scene's aspect ratio
   std::optional<int> samples;  // per pixel
-  std::optional<std::uint64_t> seed;  // replaces render.seed
+  std::optional<std::uint64_t> seed;     // replaces render.seed
+  std::optional<Integrator> integrator;  // replaces render.integrator (--integrator)
 };
 
 // The image size after a requested width and/or height. One side alone keeps the aspect ratio of
@@ -33,6 +34,9 @@ ImageSize resizeKeepingAspect(const ImageSize& current, std::optional<int> width
 // Applies the size and samples overrides to `image`; an adaptive maximum below the samples rises
 // to them.
 void applyImageOverrides(ImageSettings& image, const SceneOverrides& overrides);
+
+// Applies the seed and integrator overrides to `render`.
+void applyRenderOverrides(RenderSettings& render, const SceneOverrides& overrides);
 
 // Applies the overrides to parts.image and parts.render. Values are not range-checked here: the
 // caller re-runs the scene's image limits afterwards.

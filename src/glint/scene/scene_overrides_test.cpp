@@ -53,11 +53,18 @@ TEST(SceneOverrides, ApplyChangesOnlyWhatIsGiven) {
   EXPECT_EQ(parts.image.samples, 3);
   EXPECT_EQ(parts.render.seed, 9u);
 
-  applyOverrides(parts, {.width = 80, .height = std::nullopt, .samples = 16, .seed = 5});
+  EXPECT_EQ(parts.render.integrator, Integrator::Whitted);
+
+  applyOverrides(parts, {.width = 80,
+                         .height = std::nullopt,
+                         .samples = 16,
+                         .seed = 5,
+                         .integrator = Integrator::Path});
   EXPECT_EQ(parts.image.width, 80);
   EXPECT_EQ(parts.image.height, 60);
   EXPECT_EQ(parts.image.samples, 16);
   EXPECT_EQ(parts.render.seed, 5u);
+  EXPECT_EQ(parts.render.integrator, Integrator::Path);
 }
 
 }  // namespace
