@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "glint/core/transform.h"
 #include "glint/geometry/shape.h"
 #include "glint/render/render_test_support.h"
 #include "glint/render/renderer.h"
@@ -340,6 +341,52 @@ TEST(PathIntegrator, MisAndEachStrategyAloneConvergeToTheSameImage) {
   parts.primitives.emplace_back(Sphere::make({-1.2, 1.4, 0}, 0.3), dark, Color(40, 36, 30));
   parts.primitives.emplace_back(Rectangle::make({-2, 3, -2}, {4, 0, 0}, {0, 0, 4}), dark,
                                 Color(0.5, 0.55, 0.6));
+  Color means[3];
+  const PathLightSampling kinds[] = {PathLightSampling::Mis, PathLightSampling::LightsOnly,
+                                     PathLightSampling::BrdfOnly};
+  for (int k = 0; k < 3; ++k) {
+    SceneParts copy = parts;
+    copy.render.lightSampling = kinds[k];
+    means[k] = meanOf(render(Scene(std::move(copy))));
+  }
+  for (int k = 1; k < 3; ++k) {
+    EXPECT_NEAR(means[k].r / means[0].r, 1, 0.03) << k;
+    EXPECT_NEAR(means[k].g / means[0].g, 1, 0.03) << k;
+    EXPECT_NEAR(means[k].b / means[0].b, 1, 0.03) << k;
+  }
+}
+
+// The same agreement for the emitters sampled by their surfaces' areas beyond triangles and
+// spheres: a rotated box, a capped cylinder under a similarity, a cone frustum and an ellipse
+// (a disk under a non-uniform scale) light a diffuse floor; a wrong area or density in any of
+// them would part light sampling from BRDF sampling.
+TEST(PathIntegrator, BoxesCylindersConesAndEllipsesAreSampledAsLights) {
+  SceneParts parts = cameraParts(12, 12);
+  parts.camera.position = {0, 2, 6};
+  parts.camera.direction = normalize(Vec3{0, -0.35, -1});
+  parts.image.samples = 1024;
+  parts.primitives.emplace_back(Plane::make({0, 0, 0}, {0, 1, 0}),
+                                addMaterial(parts, diffuse(Color(0.6))), Color{});
+  const std::uint32_t dark = addMaterial(parts, diffuse(Color(0)));
+  Matrix4 turn = Matrix4::identity();  // 90° about y, scaled by 0.5, moved up
+  turn.m[0][2] = 0.5;
+  turn.m[2][0] = -0.5;
+  turn.m[0][0] = turn.m[2][2] = 0;
+  turn.m[1][1] = 0.5;
+  turn.m[1][3] = 1.5;
+  parts.primitives.emplace_back(Box::make({-1.5, 0.2, -0.5}, {-1, 0.6, 0}), dark, Color(6, 5, 4),
+                                Transform(Matrix4::identity()));
+  parts.primitives.emplace_back(Cylinder::make({2, 0, 0}, {0, 1, 0}, 0.3, 1), dark, Color(4, 6, 5),
+                                Transform(turn));
+  parts.primitives.emplace_back(Cone::make({0.5, 1.5, -1.5}, 0.3, {0.5, 2.2, -1.5}, 0.1), dark,
+                                Color(8, 4, 6));
+  Matrix4 squash = Matrix4::identity();
+  squash.m[0][0] = 2;
+  squash.m[2][2] = 0.5;
+  parts.primitives.emplace_back(Disk::make({0, 3, -0.5}, {0, -1, 0}, 0.4), dark, Color(3, 3, 3),
+                                Transform(squash));
+  ASSERT_NE(Scene(SceneParts(parts)).emitterSampler(), nullptr);
+  ASSERT_EQ(Scene(SceneParts(parts)).emitterSampler()->size(), 12u + 3 + 1 + 1);
   Color means[3];
   const PathLightSampling kinds[] = {PathLightSampling::Mis, PathLightSampling::LightsOnly,
                                      PathLightSampling::BrdfOnly};

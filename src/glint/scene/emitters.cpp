@@ -9,6 +9,29 @@
 #include "glint/core/sampling.h"
 
 namespace glint {
+namespace {
+
+// The factor by which `transform` scales every length when it is a similarity (a rotation or
+// reflection, a uniform scale and a translation), else 0: its linear part's columns must be
+// orthogonal and of one length, to a relative 1e-9.
+double similarityScale(const Transform& transform) {
+  const Vec3 x = transform(Vec3{1, 0, 0});
+  const Vec3 y = transform(Vec3{0, 1, 0});
+  const Vec3 z = transform(Vec3{0, 0, 1});
+  const double xx = dot(x, x);
+  constexpr double kTolerance = 1e-9;
+  const auto same = [&](double a) { return std::abs(a - xx) <= kTolerance * xx; };
+  const auto orthogonal = [&](const Vec3& a, const Vec3& b) {
+    return std::abs(dot(a, b)) <= kTolerance * xx;
+  };
+  if (!(xx > 0) || !same(dot(y, y)) || !same(dot(z, z)) || !orthogonal(x, y) || !orthogonal(y, z) ||
+      !orthogonal(x, z)) {
+    return 0;
+  }
+  return std::sqrt(xx);
+}
+
+}  // namespace
 
 void EmitterSampler::add(const Unit& unit, double area) {
   const double power = luminance(unit.emission) * area;
@@ -36,12 +59,38 @@ std::shared_ptr<const EmitterSampler> EmitterSampler::make(
     const double area = 0.5 * length(cross);
     if (!(area > 0)) return;
     Unit unit;
-    unit.a = a;
-    unit.b = b;
-    unit.c = c;
+    unit.origin = a;
+    unit.e0 = b - a;
+    unit.e1 = c - a;
     unit.normal = Normal3(cross / (2 * area));
     unit.emission = emission;
     s.add(unit, area);
+  };
+  // A disk or ring of object-space centre `center`, unit normal `normal` and radii, through the
+  // primitive's map to world space (null: none).
+  const auto addDisk = [&](const Transform* transform, const Point3& center, const Vec3& normal,
+                           double radius, double innerRadius, const Color& emission) {
+    Vec3 t;
+    Vec3 b;
+    orthonormalBasis(normal, t, b);
+    Unit unit;
+    unit.kind = Kind::Disk;
+    unit.origin = transform ? (*transform)(center) : center;
+    unit.e0 = transform ? (*transform)(t) : t;
+    unit.e1 = transform ? (*transform)(b) : b;
+    // World area per object area in the disk's plane (exactly 1 without a transform).
+    double stretch = 1;
+    unit.normal = Normal3(normal);
+    if (transform) {
+      const Vec3 cross = glint::cross(unit.e0, unit.e1);
+      stretch = length(cross);
+      if (!(stretch > 0)) return;
+      unit.normal = Normal3(cross / stretch);
+    }
+    unit.radius = radius;
+    unit.innerRadius = innerRadius;
+    unit.emission = emission;
+    s.add(unit, std::numbers::pi * (radius * radius - innerRadius * innerRadius) * stretch);
   };
   for (std::size_t i = 0; i < primitives.size(); ++i) {
     const Primitive& primitive = primitives[i];
@@ -49,6 +98,9 @@ std::shared_ptr<const EmitterSampler> EmitterSampler::make(
     if (!(luminance(emission) > 0) || textured(primitive.materialIndex())) continue;
     const Transform* transform = primitive.worldFromObject();
     const auto world = [&](const Point3& p) { return transform ? (*transform)(p) : p; };
+    const auto worldVector = [&](const Vec3& v) { return transform ? (*transform)(v) : v; };
+    // Round shapes stay round only under a similarity: its scale factor, or 0 for another map.
+    const double scale = transform ? similarityScale(*transform) : 1;
     const std::size_t before = s.units_.size();
     const Shape& shape = primitive.shape();
     if (const auto* triangle = std::get_if<Triangle>(&shape)) {
@@ -69,24 +121,64 @@ std::shared_ptr<const EmitterSampler> EmitterSampler::make(
       for (std::size_t k = 1; k + 1 < v.size(); ++k) {
         addTriangle(world(v[0]), world(v[k]), world(v[k + 1]), emission);
       }
-    } else if (const auto* sphere = std::get_if<Sphere>(&shape); sphere && !transform) {
+    } else if (const auto* box = std::get_if<Box>(&shape)) {
+      // Each face as two triangles between its corners (corner k has bit 0 for x, 1 y, 2 z).
+      const auto corner = [&](int k) {
+        return world(Point3{(k & 1) != 0 ? box->hi.x : box->lo.x,
+                            (k & 2) != 0 ? box->hi.y : box->lo.y,
+                            (k & 4) != 0 ? box->hi.z : box->lo.z});
+      };
+      constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                    {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+      for (const auto& face : kFaces) {
+        addTriangle(corner(face[0]), corner(face[1]), corner(face[2]), emission);
+        addTriangle(corner(face[0]), corner(face[2]), corner(face[3]), emission);
+      }
+    } else if (const auto* disk = std::get_if<Disk>(&shape)) {
+      addDisk(transform, disk->center, toVec(disk->normal), disk->radius, disk->innerRadius,
+              emission);
+    } else if (const auto* sphere = std::get_if<Sphere>(&shape); sphere && scale > 0) {
       Unit unit;
       unit.kind = Kind::Sphere;
-      unit.a = sphere->center;
-      unit.radius = sphere->radius;
+      unit.origin = world(sphere->center);
+      unit.radius = sphere->radius * scale;
       unit.emission = emission;
-      s.add(unit, 4 * std::numbers::pi * sphere->radius * sphere->radius);
-    } else if (const auto* disk = std::get_if<Disk>(&shape); disk && !transform) {
-      Unit unit;
-      unit.kind = Kind::Disk;
-      unit.a = disk->center;
-      unit.normal = disk->normal;
-      unit.radius = disk->radius;
-      unit.innerRadius = disk->innerRadius;
-      unit.emission = emission;
-      s.add(unit, std::numbers::pi *
-                      (disk->radius * disk->radius - disk->innerRadius * disk->innerRadius));
+      s.add(unit, 4 * std::numbers::pi * unit.radius * unit.radius);
+    } else if (const auto* cylinder = std::get_if<Cylinder>(&shape); cylinder && scale > 0) {
+      Vec3 t;
+      Vec3 b;
+      orthonormalBasis(cylinder->axis, t, b);
+      Unit side;
+      side.kind = Kind::CylinderSide;
+      side.origin = world(cylinder->base);
+      side.e0 = worldVector(t);
+      side.e1 = worldVector(b);
+      side.e2 = worldVector(cylinder->axis * cylinder->height);
+      side.radius = cylinder->radius;
+      side.emission = emission;
+      s.add(side, 2 * std::numbers::pi * cylinder->radius * cylinder->height * scale * scale);
+      addDisk(transform, cylinder->base, cylinder->axis, cylinder->radius, 0, emission);
+      addDisk(transform, cylinder->base + cylinder->axis * cylinder->height, cylinder->axis,
+              cylinder->radius, 0, emission);
+    } else if (const auto* cone = std::get_if<Cone>(&shape); cone && scale > 0) {
+      Vec3 t;
+      Vec3 b;
+      orthonormalBasis(cone->axis, t, b);
+      Unit side;
+      side.kind = Kind::ConeSide;
+      side.origin = world(cone->base);
+      side.e0 = worldVector(t);
+      side.e1 = worldVector(b);
+      side.e2 = worldVector(cone->axis * cone->height);
+      side.radius = cone->baseRadius;
+      side.apexRadius = cone->apexRadius;
+      side.emission = emission;
+      // Lateral area of a frustum: π·(r0 + r1)·slant height.
+      const double dr = cone->apexRadius - cone->baseRadius;
+      const double slant = std::sqrt(cone->height * cone->height + dr * dr);
+      s.add(side, std::numbers::pi * (cone->baseRadius + cone->apexRadius) * slant * scale * scale);
     }
+    // Only a primitive whose whole surface is sampled has the sampler's density at its points.
     s.sampledPrimitive_[i] = s.units_.size() > before;
   }
   for (std::size_t m = 0; m < meshes.size(); ++m) {
@@ -122,25 +214,49 @@ EmitterSampler::Sample EmitterSampler::sample(const Point2& u) const {
       const double root = std::sqrt(x);
       const double b1 = (1 - u.y) * root;
       const double b2 = u.y * root;
-      out.point = unit.a + (unit.b - unit.a) * b1 + (unit.c - unit.a) * b2;
+      out.point = unit.origin + unit.e0 * b1 + unit.e1 * b2;
       out.normal = unit.normal;
       break;
     }
     case Kind::Sphere: {
       const Vec3 d = sampleUniformSphere({x, u.y});
-      out.point = unit.a + d * unit.radius;
+      out.point = unit.origin + d * unit.radius;
       out.normal = Normal3(d);
       break;
     }
     case Kind::Disk: {
-      Vec3 t;
-      Vec3 b;
-      orthonormalBasis(toVec(unit.normal), t, b);
+      // Uniform in the object-space ring: ρ² uniform between the radii²; the linear map to
+      // world space scales every area alike.
       const double r2 = unit.innerRadius * unit.innerRadius;
       const double r = std::sqrt(r2 + x * (unit.radius * unit.radius - r2));
       const double phi = 2 * std::numbers::pi * u.y;
-      out.point = unit.a + t * (r * std::cos(phi)) + b * (r * std::sin(phi));
+      out.point = unit.origin + unit.e0 * (r * std::cos(phi)) + unit.e1 * (r * std::sin(phi));
       out.normal = unit.normal;
+      break;
+    }
+    case Kind::CylinderSide: {
+      // φ and the height uniform: the side unrolls to a rectangle.
+      const double phi = 2 * std::numbers::pi * u.y;
+      const Vec3 radial = unit.e0 * std::cos(phi) + unit.e1 * std::sin(phi);
+      out.point = unit.origin + radial * unit.radius + unit.e2 * x;
+      out.normal = Normal3(normalize(radial));
+      break;
+    }
+    case Kind::ConeSide: {
+      // The side's area grows with the radius ρ(v) = r0 + (r1 − r0)·v: v has density
+      // ∝ ρ(v), inverted as v = x·(r0 + r1) / (r0 + √(r0² + (r1 − r0)·x·(r0 + r1))), the
+      // quadratic's root in a form without cancellation (also for r0 = r1 and r0 = 0).
+      const double r0 = unit.radius;
+      const double r1 = unit.apexRadius;
+      const double v =
+          x * (r0 + r1) / (r0 + std::sqrt(std::max(0.0, r0 * r0 + (r1 - r0) * x * (r0 + r1))));
+      const double rho = r0 + (r1 - r0) * v;
+      const double phi = 2 * std::numbers::pi * u.y;
+      const Vec3 radial = unit.e0 * std::cos(phi) + unit.e1 * std::sin(phi);
+      const Vec3 around = unit.e1 * std::cos(phi) - unit.e0 * std::sin(phi);
+      out.point = unit.origin + radial * rho + unit.e2 * v;
+      // The normal: across the two tangents, along the side (∂/∂v) and around it (∂/∂φ).
+      out.normal = Normal3(normalize(cross(radial * (r1 - r0) + unit.e2, around)));
       break;
     }
   }

@@ -29,11 +29,14 @@ class EmitterSampler {
     double areaPdf = 0;
   };
 
-  // The emitters it samples: spheres, disks and rings without a transform; triangles, rectangles,
-  // quadrangles and polygons with or without one (an affine map keeps them flat); every triangle
-  // of an emissive mesh. Not sampled (found only by the paths that hit them): infinite shapes,
-  // boxes, cylinders, tubes, cones, a transformed sphere or disk, and emission with a texture.
-  // Null when there is nothing to sample.
+  // The emitters it samples, each uniformly by area: triangles, rectangles, quadrangles, polygons
+  // and boxes with or without a transform (an affine map keeps a flat face flat and a uniform
+  // point on it uniform); disks and rings likewise (an affine map makes them ellipses); spheres,
+  // capped cylinders and cones (their side, from radius to radius) without a transform or under
+  // a similarity (rotation, uniform scale, translation: they stay spheres, cylinders and cones);
+  // every triangle of an emissive mesh. Not sampled (found only by the paths that hit them):
+  // planes and tubes (infinite), spheres, cylinders and cones under a non-uniform scale or a
+  // shear, and emission with a texture. Null when there is nothing to sample.
   static std::shared_ptr<const EmitterSampler> make(const std::vector<Primitive>& primitives,
                                                     const std::vector<TriangleMesh>& meshes,
                                                     const std::vector<Material>& materials,
@@ -47,13 +50,24 @@ class EmitterSampler {
   std::size_t size() const { return units_.size(); }
 
  private:
-  enum class Kind : std::uint8_t { Triangle, Sphere, Disk };
+  enum class Kind : std::uint8_t { Triangle, Sphere, Disk, CylinderSide, ConeSide };
+  // One sampled surface in world space (scene units):
+  // - Triangle: origin + e0·b1 + e1·b2 over the barycentric triangle;
+  // - Sphere: centre origin, radius;
+  // - Disk: origin + (e0·cos φ + e1·sin φ)·ρ for innerRadius ≤ ρ ≤ radius (e0, e1 the images of
+  //   two orthonormal object-space directions in the disk's plane: an ellipse when they differ);
+  // - CylinderSide: origin + (e0·cos φ + e1·sin φ)·radius + e2·v, v in [0, 1];
+  // - ConeSide: origin + (e0·cos φ + e1·sin φ)·ρ(v) + e2·v, ρ(v) = radius + (apexRadius −
+  //   radius)·v. For both sides e0, e1 are orthogonal of equal length and e2 is the axis times
+  //   the height, all in world space.
   struct Unit {
     Kind kind = Kind::Triangle;
-    Point3 a, b, c;  // triangle vertices; sphere and disk: a is the centre
+    Point3 origin;
+    Vec3 e0, e1, e2;
     Normal3 normal;  // triangle and disk
     double radius = 0;
     double innerRadius = 0;  // disk
+    double apexRadius = 0;   // cone
     Color emission;
   };
   EmitterSampler() = default;
