@@ -1,12 +1,17 @@
 // The path integrator (issue 18): convergence, multiple importance sampling and throughput.
 //
 //   path_tracing [--runs N] [--quick] [--size WxH] [--threads T]
+//                [--only convergence|strategies|throughput]
 //
 // 1. Convergence on the Cornell box (scenes/cornell-path.yaml at --size, default 96×96): the RMS
 //    error against a high-sample reference at 4 … 256 samples per pixel and the least-squares
 //    slope of log(error) against log(spp); an unbiased Monte Carlo estimate falls as spp^−1/2.
 //    The reference is the mean of two renders of R/2 samples with seeds unlike the ladder's; its
-//    own noise (estimated from the two halves) is subtracted from the squared error.
+//    own noise (estimated from the two halves) is subtracted from the squared error. A second
+//    ladder averages N/2 renders of 2 spp with their own seeds (independent samples) and prints
+//    its slope too: glint's Sobol samples converge faster than spp^−1/2, independent ones must
+//    not be slower. (The independent ladder uses renders of 2 spp: 1 spp is the unjittered
+//    pixel centre.)
 // 2. MIS against light sampling alone and BRDF sampling alone at equal time, on a scene built here
 //    with a small bright emitter and a large dim one (the case each single strategy fails on):
 //    the time per sample of each strategy is measured first, then each renders the number of
@@ -97,25 +102,8 @@ SceneParts loadParts(const std::string& name, int width, int height) {
   return parts;
 }
 
-void convergence(int width, int height, int threads, bool quick) {
-  std::printf("1. Convergence, cornell-path.yaml at %dx%d\n", width, height);
-  SceneParts parts = loadParts("cornell-path.yaml", width, height);
-  const int referenceSpp = quick ? 1024 : 4096;
-  const auto [ref, refVariance] = reference(parts, referenceSpp, threads);
-  std::printf("   reference: %d spp, its noise RMS %.5f (subtracted)\n", referenceSpp,
-              std::sqrt(refVariance));
-  std::printf("   %6s %10s %12s\n", "spp", "seconds", "RMS error");
-  std::vector<double> xs;
-  std::vector<double> ys;
-  for (int spp = 4; spp <= 256; spp *= 2) {
-    parts.image.samples = spp;
-    parts.render.seed = 0;
-    const Rendered r = renderTimed(parts, threads);
-    const double error = correctedError(r.film, ref, refVariance);
-    std::printf("   %6d %10.3f %12.5f\n", spp, r.seconds, error);
-    xs.push_back(std::log(spp));
-    ys.push_back(std::log(error));
-  }
+// The least-squares slope of ys against xs.
+double leastSquaresSlope(const std::vector<double>& xs, const std::vector<double>& ys) {
   const double n = static_cast<double>(xs.size());
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   for (std::size_t i = 0; i < xs.size(); ++i) {
@@ -124,11 +112,56 @@ void convergence(int width, int height, int threads, bool quick) {
     sxx += xs[i] * xs[i];
     sxy += xs[i] * ys[i];
   }
-  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+void convergence(int width, int height, int threads, bool quick) {
+  std::printf("1. Convergence, cornell-path.yaml at %dx%d\n", width, height);
+  SceneParts parts = loadParts("cornell-path.yaml", width, height);
+  const int referenceSpp = quick ? 1024 : 4096;
+  const auto [ref, refVariance] = reference(parts, referenceSpp, threads);
+  std::printf("   reference: %d spp, its noise RMS %.5f (subtracted)\n", referenceSpp,
+              std::sqrt(refVariance));
+  std::printf("   %6s %10s %12s %16s\n", "spp", "seconds", "RMS error", "independent RMS");
+  // Two ladders: glint's renders at N spp (scrambled Sobol points, stratified across a pixel's
+  // samples), and the mean of N/2 renders of 2 spp with seeds 1..N/2 (independent estimates: a
+  // plain Monte Carlo mean, whose error must fall as N^-1/2 if the estimator is unbiased). Not
+  // 1 spp: a single sample goes through the pixel centre (DESIGN.md §4), unjittered.
+  std::vector<double> xs;
+  std::vector<double> ys;
+  std::vector<double> independentYs;
+  SceneParts single = parts;
+  single.image.samples = 2;
+  std::vector<Color> sum(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  int summed = 0;
+  for (int spp = 4; spp <= 256; spp *= 2) {
+    parts.image.samples = spp;
+    parts.render.seed = 0;
+    const Rendered r = renderTimed(parts, threads);
+    const double error = correctedError(r.film, ref, refVariance);
+    for (; 2 * summed < spp; ++summed) {
+      single.render.seed = static_cast<std::uint64_t>(summed) + 1;
+      const Film one = renderTimed(single, threads).film;
+      for (std::size_t i = 0; i < one.pixels().size(); ++i) sum[i] += one.pixels()[i];
+    }
+    Film mean(width, height, PixelRegion{0, 0, width, height});
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        mean.at(x, y) = sum[static_cast<std::size_t>(y) * width + x] / static_cast<double>(summed);
+      }
+    }
+    const double independent = correctedError(mean, ref, refVariance);
+    std::printf("   %6d %10.3f %12.5f %16.5f\n", spp, r.seconds, error, independent);
+    xs.push_back(std::log(spp));
+    ys.push_back(std::log(error));
+    independentYs.push_back(std::log(independent));
+  }
   std::printf(
-      "   log-log slope of the error: %.3f (independent random samples: -0.5; the scrambled "
-      "Sobol samples converge faster)\n\n",
-      slope);
+      "   log-log slope of the error: %.3f (scrambled Sobol samples converge faster than "
+      "independent ones)\n",
+      leastSquaresSlope(xs, ys));
+  std::printf("   log-log slope with independent samples: %.3f (1/sqrt(spp): -0.5)\n\n",
+              leastSquaresSlope(xs, independentYs));
 }
 
 // A room corner lit by a small bright sphere (radius 0.05, radiance 4000) and a large dim panel
@@ -231,8 +264,11 @@ void throughput(int runs, bool quick) {
 
 int main(int argc, char** argv) {
   using namespace glint::bench;
-  const std::string usage = "usage: path_tracing [--runs N] [--quick] [--size WxH] [--threads T]\n";
-  std::vector<ExtraOption> extra{ExtraOption("--size"), ExtraOption("--threads")};
+  const std::string usage =
+      "usage: path_tracing [--runs N] [--quick] [--size WxH] [--threads T] "
+      "[--only convergence|strategies|throughput]\n";
+  std::vector<ExtraOption> extra{ExtraOption("--size"), ExtraOption("--threads"),
+                                 ExtraOption("--only")};
   const CommonOptions common = parseCommonOptions(argc, argv, usage, &extra);
   int width = 96;
   int height = 96;
@@ -242,8 +278,16 @@ int main(int argc, char** argv) {
   }
   const int threads = extra[1].present ? std::atoi(extra[1].value.c_str()) : 0;
   printHeader("Path tracing: convergence, MIS, throughput", common);
-  convergence(width, height, threads, common.quick);
-  strategies(width, height, threads, common.quick);
-  throughput(common.quick ? 1 : std::max(1, common.runs), common.quick);
+  const std::string only = extra[2].present ? extra[2].value : std::string();
+  if (!only.empty() && only != "convergence" && only != "strategies" && only != "throughput") {
+    std::fprintf(stderr, "path_tracing: --only takes convergence, strategies or throughput\n%s",
+                 usage.c_str());
+    return 2;
+  }
+  if (only.empty() || only == "convergence") convergence(width, height, threads, common.quick);
+  if (only.empty() || only == "strategies") strategies(width, height, threads, common.quick);
+  if (only.empty() || only == "throughput") {
+    throughput(common.quick ? 1 : std::max(1, common.runs), common.quick);
+  }
   return 0;
 }
