@@ -1,5 +1,7 @@
 #include "glint/factories/material_factory.h"
 
+#include <limits>
+
 #include "glint/factories/build_context.h"
 #include "glint/factories/texture_library.h"
 
@@ -15,6 +17,7 @@ const std::vector<std::string_view>& materialKeys() {
                                                      "ior",
                                                      "reflection_blur",
                                                      "refraction_blur",
+                                                     "priority",
                                                      "normal_map",
                                                      "bump_map",
                                                      "bump_scale"};
@@ -48,6 +51,10 @@ std::optional<Material> readMaterial(ParameterDictionary& params, TextureLibrary
   if (const auto v = readPositive(params, "ior")) out.ior = *v;
   if (const auto v = readNonNegative(params, "reflection_blur")) out.reflectionBlur = *v;
   if (const auto v = readNonNegative(params, "refraction_blur")) out.refractionBlur = *v;
+  // Nested dielectrics (scene/media.h): an integer, higher wins where transparent solids overlap.
+  if (const auto v = readIntegerInRange(params, "priority", 0, std::numeric_limits<int>::max())) {
+    out.priority = static_cast<int>(*v);
+  }
   if (textures != nullptr) {
     for (const auto& [key, slot] :
          {std::pair{"normal_map", &bindings.normalMap}, std::pair{"bump_map", &bindings.bumpMap}}) {

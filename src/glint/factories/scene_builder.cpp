@@ -131,8 +131,8 @@ class Builder {
     const std::string path = "materials." + name;
     auto params = entityParameters(reader, e.value, e.name,
                                    "a mapping of material keys (kd, ks, shininess, kr, kt, ka, "
-                                   "ior, reflection_blur, refraction_blur, normal_map, bump_map, "
-                                   "bump_scale)",
+                                   "ior, reflection_blur, refraction_blur, priority, normal_map, "
+                                   "bump_map, bump_scale)",
                                    {"in material '" + name + "'", path, path});
     std::optional<Material> material;
     if (params) {

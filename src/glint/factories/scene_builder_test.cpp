@@ -602,8 +602,8 @@ TEST(SceneBuilder, YamlMergeKeysShareMaterialsAndObjects) {
   ASSERT_EQ(errors.size(), 2u);
   EXPECT_EQ(errors[0].format(),
             "test.yaml:4:25: unknown key 'shinyness' in material 'base'; expected one of: kd, ks, "
-            "shininess, kr, kt, ka, ior, reflection_blur, refraction_blur, normal_map, bump_map, "
-            "bump_scale (did you mean 'shininess'?)");
+            "shininess, kr, kt, ka, ior, reflection_blur, refraction_blur, priority, normal_map, "
+            "bump_map, bump_scale (did you mean 'shininess'?)");
   EXPECT_THAT(errors[1].format(), HasSubstr("test.yaml:4:25: unknown key 'shinyness' in material "
                                             "'other'"));
 }

@@ -23,6 +23,7 @@
 #include "glint/core/sampler.h"
 #include "glint/core/sampling.h"
 #include "glint/core/spawn.h"
+#include "glint/render/refraction.h"
 #include "glint/render/texturing.h"
 
 namespace glint {
@@ -86,12 +87,16 @@ struct TraceContext {
   PathLightSampling lightSampling;        // path: MIS, or one strategy alone
   int minDepth;                           // path: Russian roulette from this many hits on
   int samplesPerPixel;                    // scales camera ray differentials
+  // Scene::nestedMedia: rays carry the media they are inside (MediumStack) and refract by the
+  // ratio of the media's ior at each boundary. Otherwise the stacks stay empty and unread.
+  bool nested;
 };
 
 enum class SecondaryKind { Reflection, Refraction };
 
-Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split,
-            const SampleStream& stream, const RayDifferential* differential = nullptr);
+Color trace(const TraceContext& ctx, const Ray& ray, const MediumStack& media, int depth,
+            const Color& weight, bool split, const SampleStream& stream,
+            const RayDifferential* differential = nullptr);
 Color fogged(const TraceContext& ctx, const Color& color, const Ray& ray, double t, int depth);
 
 // The position of a point or spot light; false for a directional light (at infinity).
@@ -145,6 +150,8 @@ struct ShadingPoint {
   double nv;          // n·v
   bool hasSpecular;
   SpawnOrigins& origins;  // of p, pError and n
+  // The media on the viewer's side, where the shadow rays start (nested media only; else null).
+  const MediumStack* media;
 };
 
 // One light sample's term of DESIGN.md §3:
@@ -164,7 +171,8 @@ struct ShadingPoint {
   const Ray shadowRay = sp.origins.spawn(-l);
   const double tMax = lightPoint ? distance(shadowRay.origin, *lightPoint) : kInfinity;
   ++ctx.counts.shadow;
-  const Color transmittance = ctx.scene.transmittance(shadowRay, tMax);
+  const Color transmittance = sp.media ? ctx.scene.transmittance(shadowRay, tMax, *sp.media)
+                                       : ctx.scene.transmittance(shadowRay, tMax);
   if (isBlack(transmittance)) return Color();
 
   const Material& material = sp.material;
@@ -216,7 +224,8 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
 // count as shadow rays (both are any-hit queries).
 [[gnu::noinline]] Color ambientVisibility(const TraceContext& ctx, SpawnOrigins& origins,
                                           const Normal3& n, const Normal3& ns, double nv,
-                                          const SampleStream& stream, bool split) {
+                                          const MediumStack* media, const SampleStream& stream,
+                                          bool split) {
   const AmbientOcclusion& occlusion = *ctx.occlusion;
   const double side = nv < 0 ? 1 : -1;  // +1: the viewer is on n's side
   const Vec3 axis = toVec(ns) * side;
@@ -231,7 +240,8 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
         sampleCosineHemisphere(axis, tangent, bitangent, directions.at(stream.subIndex(count, k)));
     if (!(dot(n, w) * side > 0)) continue;
     ++ctx.counts.shadow;
-    sum += ctx.scene.transmittance(origins.spawn(w), occlusion.distance);
+    sum += media ? ctx.scene.transmittance(origins.spawn(w), occlusion.distance, *media)
+                 : ctx.scene.transmittance(origins.spawn(w), occlusion.distance);
   }
   return sum / static_cast<double>(count);
 }
@@ -283,15 +293,16 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
 // `differential` (null without textures) is that of the ideal ray; a cone ray takes its offsets
 // moved onto its own direction.
 Color traceLobe(const TraceContext& ctx, SpawnOrigins& origins, const Normal3& n, const Vec3& ideal,
-                double blurDegrees, SecondaryKind kind, int depth, const Color& weight, bool split,
-                const SampleStream& stream, const RayDifferential* differential) {
+                double blurDegrees, SecondaryKind kind, const MediumStack& media, int depth,
+                const Color& weight, bool split, const SampleStream& stream,
+                const RayDifferential* differential) {
   const bool reflection = kind == SecondaryKind::Reflection;
   std::uint64_t& counter = reflection ? ctx.counts.reflection : ctx.counts.refraction;
   const std::uint32_t dimension = reflection ? kReflectionDimension : kRefractionDimension;
   if (!(blurDegrees > 0)) {
     ++counter;
-    return trace(ctx, origins.spawn(ideal), depth, weight, split, stream.branch(dimension, 1, 0),
-                 differential);
+    return trace(ctx, origins.spawn(ideal), media, depth, weight, split,
+                 stream.branch(dimension, 1, 0), differential);
   }
   const double cosMax = std::cos(std::min(blurDegrees, 180.0) * std::numbers::pi / 180.0);
   const double idealSide = dot(n, ideal);
@@ -312,13 +323,13 @@ Color traceLobe(const TraceContext& ctx, SpawnOrigins& origins, const Normal3& n
     ++counter;
     std::optional<RayDifferential> shifted;  // built only in textured scenes
     if (differential != nullptr) shifted = shiftedDifferential(*differential, ideal, w);
-    sum += trace(ctx, origins.spawn(w), depth, weight, childSplit, SampleStream(childKey, index),
-                 shifted ? &*shifted : nullptr);
+    sum += trace(ctx, origins.spawn(w), media, depth, weight, childSplit,
+                 SampleStream(childKey, index), shifted ? &*shifted : nullptr);
     ++kept;
   }
   if (kept == 0) {
     ++counter;
-    return trace(ctx, origins.spawn(ideal), depth, weight, childSplit,
+    return trace(ctx, origins.spawn(ideal), media, depth, weight, childSplit,
                  SampleStream(childKey, stream.subIndex(count, 0)), differential);
   }
   return sum / static_cast<double>(kept);
@@ -335,31 +346,6 @@ Color traceLobe(const TraceContext& ctx, SpawnOrigins& origins, const Normal3& n
   return reflected;
 }
 
-// The transmitted direction: straight on with ior 1; otherwise Snell's law with the relative index
-// `eta` (set here; n·v < 0 means the ray enters the surface), and on total internal reflection
-// the mirror direction `reflected` (kt's energy follows the mirror ray).
-[[gnu::always_inline]] inline Vec3 transmittedDirection(double ior, const Vec3& v, const Normal3& n,
-                                                        const Normal3& ns, double nv, bool smooth,
-                                                        const Vec3& reflected, bool entering,
-                                                        double& eta) {
-  Vec3 transmitted = v;
-  if (ior != 1) {
-    eta = entering ? 1 / ior : ior;
-    const Vec3 facing = entering ? toVec(ns) : -toVec(ns);  // normal on the incident side
-    const double cosIncident = -dot(facing, v);
-    const double sin2Transmitted = eta * eta * std::max(0.0, 1 - cosIncident * cosIncident);
-    if (sin2Transmitted >= 1) {
-      transmitted = reflected;
-    } else {
-      const double cosTransmitted = std::sqrt(1 - sin2Transmitted);
-      transmitted = v * eta + facing * (eta * cosIncident - cosTransmitted);
-      // Bent about ns, it must still cross the geometric surface; otherwise go straight on.
-      if (smooth && !(dot(n, transmitted) * nv > 0)) transmitted = v;
-    }
-  }
-  return transmitted;
-}
-
 // True when a branch scaled by `factor` on top of `weight` is still worth tracing.
 bool worthTracing(const Color& factor, const Color& weight, double minWeight, Color& newWeight) {
   if (isBlack(factor)) return false;
@@ -371,9 +357,10 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
 // and shading normal as given: the hit's own, or, in a textured scene, those its textures make.
 // `textured` (null without textures) also carries the hit's footprint on to the secondary rays.
 [[gnu::always_inline]] inline Color shadeHit(
-    const TraceContext& ctx, const Ray& ray, const Hit& hit, const Material& material,
-    const Color& emission, const Normal3& shadingNormal, int depth, const Color& weight, bool split,
-    const SampleStream& stream, const TexturedHit* textured, const RayDifferential* differential) {
+    const TraceContext& ctx, const Ray& ray, const Hit& hit, const MediumStack& media,
+    const Material& material, const Color& emission, const Normal3& shadingNormal, int depth,
+    const Color& weight, bool split, const SampleStream& stream, const TexturedHit* textured,
+    const RayDifferential* differential) {
   const int hitDepth = depth + 1;
   // The reprojected hit point and its error bound: ray.at(hit.t) would carry rounding error that
   // grows with the ray's origin and length, which no offset proportional to |p| covers.
@@ -388,14 +375,16 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
   const double nsv = dot(ns, v);
 
   SpawnOrigins origins(p, pError, n);
+  const MediumStack* viewerMedia = ctx.nested ? &media : nullptr;
   Color color = emission;
   if (const Color ambient = material.ka * ctx.scene.ambient(); !isBlack(ambient)) {
     color += ctx.occlusion == nullptr
                  ? ambient
-                 : ambient * ambientVisibility(ctx, origins, n, ns, nv, stream, split);
+                 : ambient * ambientVisibility(ctx, origins, n, ns, nv, viewerMedia, stream, split);
   }
-  color += directLight(ctx, ShadingPoint{material, p, n, ns, v, nv, !isBlack(material.ks), origins},
-                       stream, split);
+  color += directLight(
+      ctx, ShadingPoint{material, p, n, ns, v, nv, !isBlack(material.ks), origins, viewerMedia},
+      stream, split);
   if (hitDepth >= ctx.maxDepth) return color;
 
   const bool smooth = !(ns == n);
@@ -407,28 +396,33 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
   if (worthTracing(material.kr, weight, ctx.minWeight, branchWeight)) {
     if (carry) childDifferential = reflectedDifferential(p, *textured, *differential, ns);
     color += material.kr * traceLobe(ctx, origins, n, reflected, material.reflectionBlur,
-                                     SecondaryKind::Reflection, hitDepth, branchWeight, split,
-                                     stream, carry ? &*childDifferential : nullptr);
+                                     SecondaryKind::Reflection, media, hitDepth, branchWeight,
+                                     split, stream, carry ? &*childDifferential : nullptr);
   }
   if (worthTracing(material.kt, weight, ctx.minWeight, branchWeight)) {
     const bool entering = nv < 0;
-    double eta = 1;
-    const Vec3 transmitted =
-        transmittedDirection(material.ior, v, n, ns, nv, smooth, reflected, entering, eta);
+    // Nested media: the relative index of the media on the two sides, and the stack of a ray that
+    // crosses (one that totally reflects stays inside `media`).
+    MediumStack beyond;
+    const double eta = ctx.nested ? ctx.scene.boundaryAt(hit, v, media, beyond).eta()
+                                  : airRelativeIndex(material.ior, entering);
+    const Vec3 transmitted = transmittedDirection(eta, v, n, ns, nv, smooth, reflected, entering);
+    const bool crosses = ctx.nested && dot(n, transmitted) * nv > 0;
     if (carry) {
       childDifferential = transmittedDifferential(p, *textured, *differential, ns, entering, eta);
     }
-    color += material.kt * traceLobe(ctx, origins, n, transmitted, material.refractionBlur,
-                                     SecondaryKind::Refraction, hitDepth, branchWeight, split,
-                                     stream, carry ? &*childDifferential : nullptr);
+    color +=
+        material.kt * traceLobe(ctx, origins, n, transmitted, material.refractionBlur,
+                                SecondaryKind::Refraction, crosses ? beyond : media, hitDepth,
+                                branchWeight, split, stream, carry ? &*childDifferential : nullptr);
   }
   return color;
 }
 
 // A textured scene's hit: its textures evaluated, its footprint from the ray's differential.
 [[gnu::noinline]] Color traceTexturedHit(const TraceContext& ctx, const Ray& ray, const Hit& hit,
-                                         int depth, const Color& weight, bool split,
-                                         const SampleStream& stream,
+                                         const MediumStack& media, int depth, const Color& weight,
+                                         bool split, const SampleStream& stream,
                                          const RayDifferential* differential) {
   TexturedHit textured;
   shadeTexturedHit(ctx.scene, hit, differential, textured);
@@ -437,20 +431,21 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
     textured.material.kd *= tint;
     textured.material.ka *= tint;
   }
-  return shadeHit(ctx, ray, hit, textured.material, textured.emission, textured.shadingNormal,
-                  depth, weight, split, stream, &textured, differential);
+  return shadeHit(ctx, ray, hit, media, textured.material, textured.emission,
+                  textured.shadingNormal, depth, weight, split, stream, &textured, differential);
 }
 
 // An untextured scene's hit on a mesh with vertex colours: they tint kd and ka at the hit
 // (TriangleMesh::colors, Tachyon's and VMD's per-vertex colours).
 [[gnu::noinline]] Color traceVertexColouredHit(const TraceContext& ctx, const Ray& ray,
-                                               const Hit& hit, int depth, const Color& weight,
-                                               bool split, const SampleStream& stream) {
+                                               const Hit& hit, const MediumStack& media, int depth,
+                                               const Color& weight, bool split,
+                                               const SampleStream& stream) {
   Material tinted = ctx.scene.materialOf(hit);
   const Color tint = ctx.scene.aggregate().vertexColor(hit);
   tinted.kd *= tint;
   tinted.ka *= tint;
-  return shadeHit(ctx, ray, hit, tinted, ctx.scene.emissionOf(hit), hit.shadingNormal, depth,
+  return shadeHit(ctx, ray, hit, media, tinted, ctx.scene.emissionOf(hit), hit.shadingNormal, depth,
                   weight, split, stream, nullptr, nullptr);
 }
 
@@ -458,12 +453,20 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
 // (0 for a camera ray), `weight` the product of kr/kt factors that scale this ray's contribution,
 // `split` whether the path has already fanned out into several glossy rays, `stream` its samples,
 // `differential` the ray's footprint (textured scenes only; else null).
-Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& weight, bool split,
-            const SampleStream& stream, const RayDifferential* differential) {
+Color trace(const TraceContext& ctx, const Ray& ray, const MediumStack& media, int depth,
+            const Color& weight, bool split, const SampleStream& stream,
+            const RayDifferential* differential) {
   // Aggregate::intersect sets every field of a hit it reports; a miss reads nothing.
   std::optional<Hit> deepHit;  // constructed only past the preallocated depths
   Hit& hit = depth < ctx.hitCount ? ctx.hits[depth] : deepHit.emplace();
-  if (!ctx.scene.intersect(ray, kInfinity, hit)) {
+  // Nested media: the boundaries that are no surface are passed, and the stack at the hit is
+  // `inside`; otherwise the ray's (empty) stack stays as it is.
+  std::optional<MediumStack> inside;
+  if (ctx.nested) inside.emplace(media);
+  const bool found = ctx.nested ? ctx.scene.intersect(ray, kInfinity, hit, *inside)
+                                : ctx.scene.intersect(ray, kInfinity, hit);
+  const MediumStack& here = ctx.nested ? *inside : media;
+  if (!found) {
     // Fog measured along rays hides whatever lies at infinity.
     if (ctx.fog && ctx.scene.fog()->distance == FogDistance::Ray) {
       return ctx.scene.fog()->color;
@@ -473,12 +476,12 @@ Color trace(const TraceContext& ctx, const Ray& ray, int depth, const Color& wei
   }
   Color color;
   if (ctx.textured) {
-    color = traceTexturedHit(ctx, ray, hit, depth, weight, split, stream, differential);
+    color = traceTexturedHit(ctx, ray, hit, here, depth, weight, split, stream, differential);
   } else if (ctx.vertexColors && hit.mesh != kNoMesh &&
              !ctx.scene.meshes()[hit.mesh].colors.empty()) {
-    color = traceVertexColouredHit(ctx, ray, hit, depth, weight, split, stream);
+    color = traceVertexColouredHit(ctx, ray, hit, here, depth, weight, split, stream);
   } else {
-    color = shadeHit(ctx, ray, hit, ctx.scene.materialOf(hit), ctx.scene.emissionOf(hit),
+    color = shadeHit(ctx, ray, hit, here, ctx.scene.materialOf(hit), ctx.scene.emissionOf(hit),
                      hit.shadingNormal, depth, weight, split, stream, nullptr, nullptr);
   }
   return ctx.fog ? fogged(ctx, color, ray, hit.t, depth) : color;
@@ -682,6 +685,8 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
   Ray ray = cameraRay;
   SampleStream stream = cameraStream;
   Hit& hit = ctx.hits[0];  // one hit at a time: nothing refers to the previous one
+  // The media the path is inside (nested media only: else it stays empty and unread).
+  MediumStack media = scene.cameraMedia();
   // The density with which the diffuse and glossy lobes drew `ray` (PhongLobes), for multiple
   // importance sampling where it meets the image environment; 0 for camera rays and specular
   // lobes, which the environment's samples never stand in for.
@@ -699,7 +704,8 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
     throughput *= f;
   };
   for (int depth = 0;; ++depth) {
-    const bool found = scene.intersect(ray, kInfinity, hit);
+    const bool found = ctx.nested ? scene.intersect(ray, kInfinity, hit, media)
+                                  : scene.intersect(ray, kInfinity, hit);
     if (seesLights && !scene.lightSurfaces().empty()) {
       // The nearest area light in front of the hit is what the ray sees; a light reflects
       // nothing, so the path ends there.
@@ -769,9 +775,10 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
     const double nsv = dot(ns, v);
     SpawnOrigins origins(p, hit.pointError, n);
     radiance +=
-        throughput *
-        directLight(ctx, ShadingPoint{material, p, n, ns, v, nv, !isBlack(material.ks), origins},
-                    stream, false);
+        throughput * directLight(ctx,
+                                 ShadingPoint{material, p, n, ns, v, nv, !isBlack(material.ks),
+                                              origins, ctx.nested ? &media : nullptr},
+                                 stream, false);
     if (depth + 1 >= ctx.maxDepth) break;
 
     // Past the lights' direct term a surface passes on at most the light it receives: materials
@@ -840,10 +847,14 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
       ++ctx.counts.reflection;
     } else {
       const bool entering = nv < 0;
-      double eta = 1;
-      const Vec3 transmitted =
-          transmittedDirection(material.ior, v, n, ns, nv, smooth, reflected, entering, eta);
+      MediumStack beyond;
+      const double eta = ctx.nested ? scene.boundaryAt(hit, v, media, beyond).eta()
+                                    : airRelativeIndex(material.ior, entering);
+      const Vec3 transmitted = transmittedDirection(eta, v, n, ns, nv, smooth, reflected, entering);
       w = specularLobeDirection(transmitted, material.refractionBlur, n, stream);
+      // A ray that crosses the surface is inside the media beyond it; one that totally reflects
+      // stays.
+      if (ctx.nested && dot(n, w) * nv > 0) media = beyond;
       factor = material.kt * (total / transmit);
       ++ctx.counts.refraction;
     }
@@ -868,8 +879,8 @@ Color traceCameraRay(const TraceContext& ctx, const Ray& ray, const SampleStream
   if (ctx.path) {
     return tracePath(ctx, Ray{ray.origin, normalize(ray.direction)}, stream, differential);
   }
-  return trace(ctx, Ray{ray.origin, normalize(ray.direction)}, 0, Color(1), false, stream,
-               differential);
+  return trace(ctx, Ray{ray.origin, normalize(ray.direction)}, ctx.scene.cameraMedia(), 0, Color(1),
+               false, stream, differential);
 }
 
 // The per-depth hits a TraceContext points into (one allocation per tile, not per ray): one per
@@ -905,7 +916,8 @@ TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>
                       scene.emitterSampler(),
                       settings.lightSampling,
                       settings.minDepth,
-                      samplesPerPixel(scene.image()).minimum};
+                      samplesPerPixel(scene.image()).minimum,
+                      scene.nestedMedia()};
 }
 
 PixelRegion validatedRegion(const Scene& scene, const RenderOptions& options) {

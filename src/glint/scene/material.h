@@ -22,6 +22,9 @@ struct Material {
   double ior = 1;             // index of refraction; 1 = straight through
   double reflectionBlur = 0;  // glossy cone half-angle, degrees
   double refractionBlur = 0;  // glossy cone half-angle, degrees
+  // Nested dielectrics (scene/media.h): where transparent solids overlap, the medium of higher
+  // priority owns the overlap; equal priorities: the one the ray entered last.
+  int priority = 0;
   // Index of its MaterialTextures (scene/texture.h) in SceneParts::materialTextures, or
   // kUntextured. A textured coefficient is its constant above times the texture's value.
   std::uint32_t textures = kUntextured;

@@ -1,10 +1,14 @@
 // Scene construction: camera from the image size, material validation, the frozen aggregate.
 #include "glint/scene/scene.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <variant>
+
+#include "glint/core/spawn.h"
 
 namespace glint {
 
@@ -83,7 +87,107 @@ Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materia
                    std::move(meshTransmission), parts.acceleration);
 }
 
+// Whether a shape bounds a volume with outward normals, so that a ray crossing it enters or leaves
+// a medium (nested dielectrics). Flat shapes, the open cone and planes are surfaces without an
+// inside. One overload per shape: a new shape does not compile until it is classified here.
+struct BoundsVolume {
+  bool operator()(const Sphere&) const { return true; }
+  bool operator()(const Box&) const { return true; }
+  bool operator()(const Cylinder&) const { return true; }
+  bool operator()(const Tube&) const { return true; }
+  bool operator()(const Plane&) const { return false; }
+  bool operator()(const Triangle&) const { return false; }
+  bool operator()(const Polygon&) const { return false; }
+  bool operator()(const Rectangle&) const { return false; }
+  bool operator()(const Quadrangle&) const { return false; }
+  bool operator()(const Disk&) const { return false; }
+  bool operator()(const Cone&) const { return false; }
+};
+
+// Whether some transparent solid's bounds overlap another transparent object's (solid or flat):
+// the only way a ray can be inside two media at once, or meet a flat transparent surface inside a
+// medium. Sweep and prune along x; past a budget of box tests the answer is a conservative yes.
+bool transparentSolidsOverlap(const std::vector<Primitive>& primitives,
+                              const std::vector<TriangleMesh>& meshes,
+                              const std::vector<Material>& materials) {
+  struct Candidate {
+    Bounds3 bounds;
+    bool solid;
+  };
+  std::vector<Candidate> candidates;
+  bool anySolid = false;
+  for (const Primitive& primitive : primitives) {
+    if (isBlack(materials[primitive.materialIndex()].kt)) continue;
+    const bool solid = std::visit(BoundsVolume{}, primitive.shape());
+    anySolid = anySolid || solid;
+    candidates.push_back({primitive.bounds(), solid});
+  }
+  if (!anySolid) return false;
+  for (const TriangleMesh& mesh : meshes) {
+    if (isBlack(materials[mesh.materialIndex].kt) || mesh.positions.empty()) continue;
+    Bounds3 bounds;
+    for (const Point3& p : mesh.positions) bounds = unite(bounds, Bounds3(p, p));
+    candidates.push_back({bounds, false});
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const Candidate& a, const Candidate& b) { return a.bounds.lo.x < b.bounds.lo.x; });
+  constexpr std::size_t kTestBudget = std::size_t{1} << 24;
+  std::size_t tests = 0;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const Candidate& a = candidates[i];
+    for (std::size_t j = i + 1; j < candidates.size() && candidates[j].bounds.lo.x <= a.bounds.hi.x;
+         ++j) {
+      if (++tests > kTestBudget) return true;
+      const Candidate& b = candidates[j];
+      if (!(a.solid || b.solid)) continue;
+      if (a.bounds.lo.y <= b.bounds.hi.y && b.bounds.lo.y <= a.bounds.hi.y &&
+          a.bounds.lo.z <= b.bounds.hi.z && b.bounds.lo.z <= a.bounds.hi.z) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
 }  // namespace
+
+bool Scene::intersect(const Ray& ray, double tMax, Hit& hit, MediumStack& media) const {
+  Ray segment = ray;
+  double travelled = 0;
+  for (int passed = 0;; ++passed) {
+    if (!aggregate_.intersect(segment, 0, tMax - travelled, hit)) return false;
+    MediumStack beyond;
+    if (passed == kMaxPassedBoundaries || boundaryAt(hit, ray.direction, media, beyond).surface) {
+      hit.t += travelled;
+      return true;
+    }
+    media = beyond;
+    travelled += hit.t;
+    segment = spawnRay(hit.point, hit.pointError, hit.normal, ray.direction);
+  }
+}
+
+Color Scene::transmittance(const Ray& ray, double tMax, const MediumStack& start) const {
+  MediumStack media = start;
+  Color result(1);
+  Ray segment = ray;
+  double travelled = 0;
+  Hit hit;
+  for (int crossing = 0; crossing < kMaxShadowCrossings; ++crossing) {
+    if (!aggregate_.intersect(segment, 0, tMax - travelled, hit)) return result;
+    MediumStack beyond;
+    if (boundaryAt(hit, ray.direction, media, beyond).surface) {
+      const Color& kt = materialTransmission_[materialIndexOf(hit)];
+      if (isBlack(kt)) return Color();
+      result *= kt;
+      if (isBlack(result)) return Color();
+    }
+    media = beyond;
+    travelled += hit.t;
+    segment = spawnRay(hit.point, hit.pointError, hit.normal, ray.direction);
+  }
+  return result * aggregate_.transmittance(segment, 0, tMax - travelled);
+}
 
 Scene::Scene(SceneParts parts)
     : name_((checkTextures(parts), std::move(parts.name))),
@@ -106,6 +210,7 @@ Scene::Scene(SceneParts parts)
                           ? EmitterSampler::make(aggregate_.primitives(), aggregate_.meshes(),
                                                  materials_, materialTextures_)
                           : nullptr) {
+  initialiseMedia();
   if (render_.integrator != Integrator::Path) return;
   for (const Light& light : lights_) {
     const auto* area = std::get_if<AreaLight>(&light);
@@ -124,6 +229,53 @@ Scene::Scene(SceneParts parts)
         break;
     }
   }
+}
+
+void Scene::initialiseMedia() {
+  const std::vector<Primitive>& primitives = aggregate_.primitives();
+  primitiveMedium_.reserve(primitives.size());
+  for (const Primitive& primitive : primitives) {
+    const std::uint32_t material = primitive.materialIndex();
+    const bool medium =
+        !isBlack(materials_[material].kt) && std::visit(BoundsVolume{}, primitive.shape());
+    primitiveMedium_.push_back(medium ? material : kNoMedium);
+  }
+  materialTransmission_.reserve(materials_.size());
+  for (const Material& material : materials_) {
+    materialTransmission_.push_back(shadowTransmission(material, textures_, materialTextures_));
+  }
+  nestedMedia_ = transparentSolidsOverlap(primitives, aggregate_.meshes(), materials_);
+  if (!nestedMedia_) return;
+
+  // The camera's media: march along its view direction through every surface; a solid whose first
+  // crossing leaves it contains the camera. (A thin lens's other ray origins are taken to lie in
+  // the same media.)
+  struct Leaving {
+    double t;
+    std::uint32_t medium;
+  };
+  std::vector<Leaving> leaving;
+  std::unordered_set<std::uint64_t> seen;  // objects met: primitive, or mesh << 32
+  constexpr int kMaxCameraCrossings = 4096;
+  const Vec3 direction = camera_.toward();
+  Ray segment{camera_.position(), direction};
+  double travelled = 0;
+  Hit hit;
+  for (int k = 0; k < kMaxCameraCrossings; ++k) {
+    if (!aggregate_.intersect(segment, 0, kInfinity, hit)) break;
+    travelled += hit.t;
+    const std::uint64_t object = hit.mesh == kNoMesh
+                                     ? hit.primitive
+                                     : (std::uint64_t{hit.mesh} << 32 | std::uint64_t{1} << 63);
+    if (seen.insert(object).second && mediumOf(hit) != kNoMedium &&
+        dot(hit.normal, direction) > 0) {
+      leaving.push_back({travelled, mediumOf(hit)});
+    }
+    segment = spawnRay(hit.point, hit.pointError, hit.normal, direction);
+  }
+  std::stable_sort(leaving.begin(), leaving.end(),
+                   [](const Leaving& a, const Leaving& b) { return a.t > b.t; });
+  for (const Leaving& l : leaving) cameraMedia_.push(l.medium);
 }
 
 }  // namespace glint

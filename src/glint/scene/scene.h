@@ -18,6 +18,7 @@
 #include "glint/scene/fog.h"
 #include "glint/scene/light.h"
 #include "glint/scene/material.h"
+#include "glint/scene/media.h"
 #include "glint/scene/texture.h"
 
 namespace glint {
@@ -158,7 +159,49 @@ class Scene {
     return aggregate_.transmittance(ray, 0, tMax);
   }
 
+  // ---- Nested dielectrics (DESIGN.md §11, scene/media.h) ----
+  // A transparent solid is a sphere, box, cylinder or tube whose material has kt > 0; its medium
+  // is its material. Rays track the media they are inside only when some transparent solid's
+  // bounds overlap another transparent object's: otherwise no ray can be inside two media at once
+  // or meet a boundary that is no surface, every surface refracts against air exactly as the
+  // queries above assume, and the renderer uses them unchanged.
+  bool nestedMedia() const { return nestedMedia_; }
+  // The media the camera's position is inside (nestedMedia only, else empty): the transparent
+  // solids that the ray from the camera along its view direction leaves before entering, the one it
+  // leaves farthest away outermost.
+  const MediumStack& cameraMedia() const { return cameraMedia_; }
+  std::uint32_t materialIndexOf(const Hit& hit) const {
+    return hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].materialIndex()
+                               : aggregate_.meshes()[hit.mesh].materialIndex;
+  }
+  // The medium the hit's surface bounds: its material index for a transparent solid, else
+  // kNoMedium. These queries follow the nested rule in any scene; the renderer uses them only
+  // when nestedMedia().
+  std::uint32_t mediumOf(const Hit& hit) const {
+    return hit.mesh == kNoMesh ? primitiveMedium_[hit.primitive] : kNoMedium;
+  }
+  // The boundary a ray with unit `direction` inside `media` meets at `hit` (crossBoundary).
+  Boundary boundaryAt(const Hit& hit, const Vec3& direction, const MediumStack& media,
+                      MediumStack& beyond) const {
+    return crossBoundary(media, materialIndexOf(hit), mediumOf(hit), dot(hit.normal, direction) < 0,
+                         materials_, beyond);
+  }
+  // The closest hit on a surface for a ray inside `media`: the boundaries before it that are no
+  // surface are passed, and `media` becomes the stack at the hit. hit.t is the distance along
+  // `ray` (summed over the passed segments). After kMaxPassedBoundaries passed in a row the next
+  // boundary counts as a surface (a bound on hostile scenes of many coincident solids).
+  static constexpr int kMaxPassedBoundaries = 64;
+  bool intersect(const Ray& ray, double tMax, Hit& hit, MediumStack& media) const;
+  // Shadow transmittance for a ray that starts inside `media`: the product of kt over the surfaces
+  // it crosses in (0, tMax), boundaries that are no surface left out (a glass sphere inside a glass
+  // sphere of the same material costs one sphere's kt²). Crossings are visited in order, one
+  // closest-hit query each; past kMaxShadowCrossings the rest of the way counts every crossing.
+  static constexpr int kMaxShadowCrossings = 256;
+  Color transmittance(const Ray& ray, double tMax, const MediumStack& media) const;
+
  private:
+  void initialiseMedia();
+
   std::string name_;
   std::vector<Material> materials_;
   std::vector<Texture> textures_;
@@ -175,6 +218,10 @@ class Scene {
   Aggregate aggregate_;
   std::shared_ptr<const EmitterSampler> emitterSampler_;  // after aggregate_: built from it
   std::vector<LightSurface> lightSurfaces_;
+  bool nestedMedia_ = false;
+  std::vector<std::uint32_t> primitiveMedium_;  // per primitive: mediumOf
+  std::vector<Color> materialTransmission_;     // per material: the kt a shadow ray keeps
+  MediumStack cameraMedia_;
 };
 
 }  // namespace glint
