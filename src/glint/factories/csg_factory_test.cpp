@@ -94,7 +94,7 @@ TEST(CsgFactory, OpenShapesAreErrorsAtTheirType) {
                          "      - {type: sphere, center: [0, 0, 0], radius: 1}\n"
                          "      - {type: " +
                          std::string(type) + "}\n"),
-                   8, 16, "is not a closed shape");
+                   9, 16, "is not a closed shape");
   }
 }
 
@@ -106,7 +106,7 @@ TEST(CsgFactory, AMeshThatIsNotClosedIsAnErrorAtItsPositions) {
             "      - {type: sphere, center: [0, 0, 0], radius: 1}\n"
             "      - {type: mesh, positions: [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],\n"
             "         indices: [[0, 2, 1], [0, 1, 3], [0, 3, 2], [0, 1, 2]]}\n"),
-      8, 32, "closed, consistently oriented surface");
+      9, 33, "closed, consistently oriented surface");
   expectOneError(
       scene("  - type: csg\n"
             "    operation: union\n"
@@ -115,7 +115,7 @@ TEST(CsgFactory, AMeshThatIsNotClosedIsAnErrorAtItsPositions) {
             "      - {type: mesh, positions: [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1],\n"
             "                                 [5, 5, 5]],\n"
             "         indices: [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 4]]}\n"),
-      8, 32, "belongs to only one triangle");
+      9, 33, "belongs to only one triangle");
 }
 
 TEST(CsgFactory, KeyAndValueErrorsNameTheirPlace) {
@@ -123,25 +123,25 @@ TEST(CsgFactory, KeyAndValueErrorsNameTheirPlace) {
   expectOneError(scene("  - {type: csg, operation: unoin, operands: [\n"
                        "      {type: sphere, center: [0, 0, 0], radius: 1},\n"
                        "      {type: sphere, center: [1, 0, 0], radius: 1}]}\n"),
-                 5, 30, "did you mean 'union'");
+                 5, 28, "did you mean 'union'");
   // Unknown keys: of the csg, of an operand.
   expectOneError(scene("  - {type: csg, operation: union, colour: red, operands: [\n"
                        "      {type: sphere, center: [0, 0, 0], radius: 1},\n"
                        "      {type: sphere, center: [1, 0, 0], radius: 1}]}\n"),
-                 5, 37, "unknown key 'colour'");
+                 5, 35, "unknown key 'colour'");
   expectOneError(scene("  - {type: csg, operation: union, operands: [\n"
                        "      {type: sphere, center: [0, 0, 0], radius: 1},\n"
                        "      {type: sphere, center: [1, 0, 0], raduis: 1}]}\n"),
-                 7, 42, "did you mean 'radius'");
+                 7, 41, "did you mean 'radius'");
   // A bad value inside an operand.
   expectOneError(scene("  - {type: csg, operation: union, operands: [\n"
                        "      {type: sphere, center: [0, 0, 0], radius: 1},\n"
                        "      {type: sphere, center: [1, 0, 0], radius: -1}]}\n"),
-                 7, 50, "radius must be > 0");
+                 7, 49, "radius must be > 0");
   // Too few operands, an unknown operand type, an undefined material.
   expectOneError(scene("  - {type: csg, operation: union, operands: [\n"
                        "      {type: sphere, center: [0, 0, 0], radius: 1}]}\n"),
-                 5, 46, "at least two objects");
+                 5, 45, "at least two objects");
   expectOneError(scene("  - {type: csg, operation: union, operands: [\n"
                        "      {type: sphere, center: [0, 0, 0], radius: 1},\n"
                        "      {type: sphear, center: [1, 0, 0], radius: 1}]}\n"),
@@ -149,7 +149,7 @@ TEST(CsgFactory, KeyAndValueErrorsNameTheirPlace) {
   expectOneError(scene("  - {type: csg, operation: union, operands: [\n"
                        "      {type: sphere, center: [0, 0, 0], radius: 1, material: rde},\n"
                        "      {type: sphere, center: [1, 0, 0], radius: 1}]}\n"),
-                 6, 60, "undefined material 'rde'");
+                 6, 62, "undefined material 'rde'");
   expectOneError(scene("  - {type: csg, operation: union}\n"), 5, 5,
                  "missing required key 'operands'");
 }

@@ -80,7 +80,7 @@ TEST(CsgRender, TheCutFaceOfASphereMinusABoxFacesOutOfTheCut) {
       "lights:\n"
       "  - {type: directional, direction: [0, 0, -1], color: [1, 1, 1], intensity: 1}\n");
   const Film film = render(scene);
-  for (const auto [x, y] : {std::pair{10, 10}, std::pair{7, 12}, std::pair{13, 9}}) {
+  for (const auto& [x, y] : {std::pair{10, 10}, std::pair{7, 12}, std::pair{13, 9}}) {
     EXPECT_EQ(film.at(x, y), Color(0.5, 0.25, 0.125)) << x << ", " << y;
   }
   EXPECT_EQ(film.at(0, 0), Color(0, 0, 1));
