@@ -652,6 +652,7 @@ bool Aggregate::intersect(const Ray& ray, double tMin, double tMax, Hit& hit) co
     hit.primitive = hitIndex;
     hit.mesh = kNoMesh;
     hit.triangle = 0;
+    hit.part = primitiveHit.part;
   }
   return found != Found::None;
 }
@@ -663,6 +664,10 @@ Color Aggregate::transmittance(const Ray& ray, double tMin, double tMax) const {
   const auto cross = [&](std::uint32_t index) {
     const Color& kt = transmission_[index];
     if (kt == Color(1)) return true;  // fully transparent: crossings cannot change the product
+    if (primitives_[index].csg() != nullptr) {  // each crossing with its operand's kt
+      result *= primitives_[index].csgTransmittance(ray, tMin, tMax);
+      return !isBlack(result);
+    }
     const int crossings = primitives_[index].crossings(ray, tMin, tMax);
     if (crossings == 0) return true;
     if (isBlack(kt)) return false;
@@ -752,6 +757,7 @@ bool Aggregate::intersectBruteForce(const Ray& ray, double tMin, double tMax, Hi
       hit.primitive = i;
       hit.mesh = kNoMesh;
       hit.triangle = 0;
+      hit.part = shapeHit.part;
       found = true;
     }
   }
@@ -787,6 +793,11 @@ Color Aggregate::transmittanceBruteForce(const Ray& ray, double tMin, double tMa
   for (std::uint32_t i = 0; i < primitives_.size(); ++i) {
     const Color& kt = transmission_[i];
     if (kt == Color(1)) continue;
+    if (primitives_[i].csg() != nullptr) {  // each crossing with its operand's kt
+      result *= primitives_[i].csgTransmittance(ray, tMin, tMax);
+      if (isBlack(result)) return Color();
+      continue;
+    }
     const int crossings = primitives_[i].crossings(ray, tMin, tMax);
     if (crossings == 0) continue;
     if (isBlack(kt)) return Color();

@@ -30,6 +30,7 @@ struct Hit {
   std::uint32_t primitive = 0;   // index into the primitives, when mesh == kNoMesh
   std::uint32_t mesh = kNoMesh;  // index into the meshes, or kNoMesh for an analytic primitive
   std::uint32_t triangle = 0;    // triangle index within meshes()[mesh] (see meshes())
+  std::uint32_t part = 0;        // on a csg primitive: the operand hit (ShapeHit::part)
 };
 
 // How the Aggregate organises its primitives: a BVH, or none (every ray tests every primitive —
@@ -39,7 +40,9 @@ enum class Acceleration { Bvh, BruteForce };
 class Aggregate {
  public:
   // primitiveTransmission[i] is the factor a shadow ray keeps each time it crosses primitive i
-  // (the material's kt); same size as primitives.
+  // (the material's kt); same size as primitives. For a csg primitive it only says whether the
+  // csg may dim a shadow ray (1: every operand is fully transparent); the crossings of its surface
+  // count with their operands' own transmission (CsgOperand::transmission).
   // meshTransmission[m] likewise for every triangle of meshes[m]; same size as meshes.
   // Throws std::invalid_argument for mismatched sizes, a mesh whose index count is not a multiple
   // of 3, an index past the mesh's positions, or normals that are neither absent nor one per

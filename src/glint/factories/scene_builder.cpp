@@ -1,5 +1,6 @@
 #include "glint/factories/scene_builder.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -15,6 +16,7 @@
 
 #include "glint/core/cancel.h"
 #include "glint/core/transform.h"
+#include "glint/factories/csg_factory.h"
 #include "glint/factories/light_factories.h"
 #include "glint/factories/material_factory.h"
 #include "glint/factories/mesh_textures.h"
@@ -57,6 +59,7 @@ class Builder {
         }) {
     ctx_.textures = &textures_;
     for (const ObjectFactory& f : objectFactories()) objectTypes_.push_back(f.type);
+    objectTypes_.push_back(csgFactory_.type);
     for (const ObjectFactory& f : options_.extraObjectFactories) objectTypes_.push_back(f.type);
     for (const LightFactory& f : lightFactories()) lightTypes_.push_back(f.type);
   }
@@ -239,7 +242,8 @@ class Builder {
     }
     const ObjectFactory* factory = factoryOf<ObjectFactory>(
         reader, e, "object", path, objectTypes_, [this](std::string_view type) {
-          return findObjectFactory(type, options_.extraObjectFactories);
+          return type == csgFactory_.type ? &csgFactory_
+                                          : findObjectFactory(type, options_.extraObjectFactories);
         });
     if (factory == nullptr) {
       // Without a type the keys cannot be checked; duplicates still are.
@@ -266,6 +270,10 @@ class Builder {
       emission = readColor(params, "emission", ctx_.encoding);
     }
     const TransformResult transform = readTransform(params, type);
+    if (factory == &csgFactory_) {
+      buildCsg(e, params, material, emission.value_or(Color()), emissionTexture, transform);
+      return;
+    }
     std::optional<ObjectGeometry> geometry;
     std::optional<ShapeError> degenerate;
     try {
@@ -292,6 +300,31 @@ class Builder {
       objectPlaces_.push_back({e.file, e.value, false});
     } catch (const ShapeError& error) {
       reportShapeError(params, factory->keys, error, fmt::format("{} ({})", path, type));
+    }
+  }
+
+  // A csg object (DESIGN.md §11, factories/csg_factory.h): one primitive; operands without a
+  // material or emission of their own take the object's.
+  void buildCsg(const Entity& e, ParameterDictionary& params, MaterialChoice material,
+                const Color& emission, const std::optional<TextureId>& emissionTexture,
+                const TransformResult& transform) {
+    if (emissionTexture) material.index = withEmissionTexture(material.index, *emissionTexture);
+    CsgServices services{
+        [this](ParameterDictionary& p, const std::string& owner) -> std::optional<std::uint32_t> {
+          if (!p.has("material")) return std::nullopt;
+          return resolveMaterial(p, owner).index;
+        },
+        [this](ParameterDictionary& p, const MeshRequest& request) { return loadMesh(p, request); },
+        ctx_.encoding};
+    std::optional<Csg> csg = readCsg(params, "csg", material.index, emission, services);
+    params.finish();
+    if (!csg || params.errors() != 0 || !transform.ok) return;
+    try {
+      parts_.primitives.emplace_back(std::move(*csg), material.index, emission,
+                                     transform.worldFromObject);
+      objectPlaces_.push_back({e.file, e.value, false});
+    } catch (const ShapeError& error) {
+      params.error(params.place(), fmt::format("objects[{}] (csg): {}", e.index, error.what()));
     }
   }
 
@@ -330,15 +363,12 @@ class Builder {
     return indices;
   }
 
-  // A mesh object (DESIGN.md §5, §7): its file read once per scene through meshCache_, instanced
-  // with the object's transform. The object's `material` replaces every material of the file
-  // (their emission too); its `emission` replaces the files' emission. A file that cannot be
-  // loaded is an error at the object naming the file as written; dropped degenerate triangles are
-  // one warning there.
-  void buildMesh(ParameterDictionary& params, const MeshRequest& request,
-                 const MaterialChoice& material, const std::optional<Color>& emission,
-                 const std::optional<Transform>& worldFromFile,
-                 const std::optional<TextureId>& emissionTexture) {
+  // A mesh object's contents: its file read once per scene through meshCache_ (estimated against
+  // the memory limit first), or its inline arrays, counted against the scene's triangle limit.
+  // Null after an error at the object naming the file as written; dropped degenerate triangles
+  // are one warning there.
+  std::shared_ptr<const MeshFile> loadMesh(ParameterDictionary& params,
+                                           const MeshRequest& request) {
     const std::filesystem::path written(request.file);
     const std::filesystem::path path =
         written.is_relative() ? baseDirectory(params) / written : written;
@@ -364,7 +394,7 @@ class Builder {
                               escapeForMessage(path.string()));
       }
       params.error(params.place(), fmt::format("cannot load mesh file '{}': {}", shown, reason));
-      return;
+      return nullptr;
     }
     const std::uint64_t triangles = file->triangleCount();
     if (meshTriangles_ + triangles > kMaxMeshTriangles) {
@@ -373,7 +403,7 @@ class Builder {
                                "than the limit of {}",
                                named, formatCount(static_cast<double>(meshTriangles_ + triangles)),
                                formatCount(static_cast<double>(kMaxMeshTriangles))));
-      return;
+      return nullptr;
     }
     meshTriangles_ += triangles;
     if (file->droppedTriangles > 0) {
@@ -383,6 +413,22 @@ class Builder {
                                 named, file->droppedTriangles,
                                 file->droppedTriangles == 1 ? "" : "s", triangles));
     }
+    return file;
+  }
+
+  // A mesh object (DESIGN.md §5, §7): its contents (loadMesh) instanced with the object's
+  // transform. The object's `material` replaces every material of the file (their emission too);
+  // its `emission` replaces the files' emission.
+  void buildMesh(ParameterDictionary& params, const MeshRequest& request,
+                 const MaterialChoice& material, const std::optional<Color>& emission,
+                 const std::optional<Transform>& worldFromFile,
+                 const std::optional<TextureId>& emissionTexture) {
+    const std::shared_ptr<const MeshFile> file = loadMesh(params, request);
+    if (file == nullptr) return;
+    const std::filesystem::path written(request.file);
+    const std::filesystem::path path =
+        written.is_relative() ? baseDirectory(params) / written : written;
+    const std::string shown = escapeForMessage(request.file);
     const std::vector<std::uint32_t>* scene = nullptr;
     if (!material.given) {
       try {
@@ -487,6 +533,11 @@ class Builder {
     return !isBlack(emission) || !isBlack(m.kr) || !isBlack(m.kt);
   }
 
+  bool isDark(const Color& emission, std::uint32_t material) const {
+    const Material& m = parts_.materials[material];
+    return isBlack(emission) && isBlack(m.kd) && isBlack(m.ks) && isBlack(m.kr) && isBlack(m.kt);
+  }
+
   // Objects shade black without any light, ambient, emission or mirror/glass to show the
   // background; that is almost always a forgotten `lights` or `ambient` section.
   void warnIfUnlit() {
@@ -496,6 +547,11 @@ class Builder {
     }
     for (const Primitive& p : parts_.primitives) {
       if (shows(p.emission(), p.materialIndex())) return;
+      if (const Csg* csg = p.csg()) {
+        for (const CsgOperand& o : csg->tree->operands) {
+          if (shows(o.emission, o.materialIndex)) return;
+        }
+      }
     }
     for (const TriangleMesh& mesh : parts_.meshes) {
       if (shows(mesh.emission, mesh.materialIndex)) return;
@@ -513,10 +569,14 @@ class Builder {
     std::size_t dark = 0;
     for (std::size_t i = 0; i < parts_.primitives.size(); ++i) {
       const Primitive& p = parts_.primitives[i];
-      const Material& m = parts_.materials[p.materialIndex()];
-      if (!isBlack(p.emission()) || !isBlack(m.kd) || !isBlack(m.ks) || !isBlack(m.kr) ||
-          !isBlack(m.kt)) {
-        continue;
+      if (!isDark(p.emission(), p.materialIndex())) continue;
+      if (const Csg* csg = p.csg()) {
+        const auto& operands = csg->tree->operands;
+        if (!std::all_of(operands.begin(), operands.end(), [&](const CsgOperand& o) {
+              return isDark(o.emission, o.materialIndex);
+            })) {
+          continue;
+        }
       }
       if (++dark > kMaxDarkObjectWarnings) continue;
       const ObjectPlace& place = objectPlaces_[i];
@@ -559,6 +619,8 @@ class Builder {
   BuildContext ctx_;
   BuildResult& result_;
   std::map<std::string, std::uint32_t, std::less<>> materialIndex_;
+  // `csg` has no entry in objectFactories(): its operands need the builder (materials, meshes).
+  const ObjectFactory csgFactory_{"csg", kCsgKeys, nullptr};
   std::map<std::uint32_t, std::pair<std::uint32_t, TextPosition>> materialWhere_;  // file, place
   MeshCache meshCache_;  // each mesh file read once per scene
   std::map<const MeshFile*, std::vector<std::uint32_t>> fileMaterials_;

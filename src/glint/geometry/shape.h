@@ -42,6 +42,9 @@ struct ShapeHit {
   // through the box point ± pointError. Both in the space of the ray. For spawnRay (core/spawn.h).
   Point3 point;
   Vec3 pointError;
+  // On a csg: the operand shape hit (an index into its CsgTree::operands), for its material and
+  // surface coordinates. Not set by other shapes: read it only for a hit on a Csg.
+  std::uint32_t part = 0;
 };
 
 // Conventions shared by every shape below:
@@ -207,8 +210,24 @@ struct Cone {
 // The direction across a cone's unit axis from which its u coordinate is measured (see Cone).
 Vec3 coneReference(const Vec3& axis);
 
+struct CsgTree;  // csg.h
+
+// Constructive solid geometry (DESIGN.md §11): the union, intersection or difference of closed
+// shapes, nested freely, as one shape. csg.h builds the tree and implements the queries (crossings
+// of every operand along the ray combined by the operations, Roth 1982); hits name the operand
+// they are on in ShapeHit::part. Normals point out of the combined solid.
+struct Csg {
+  std::shared_ptr<const CsgTree> tree;
+  bool intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const;
+  int crossings(const Ray& ray, double tMin, double tMax) const;
+  Bounds3 bounds() const;
+  // The normal of the surface that a short segment through p along x, y or z (the first that
+  // crosses it) meets; (0, 0, 0) when none does (p is not on the surface).
+  Normal3 normalAt(const Point3& p) const;
+};
+
 using Shape = std::variant<Sphere, Plane, Triangle, Polygon, Rectangle, Quadrangle, Tube, Cylinder,
-                           Box, Disk, Cone>;
+                           Box, Disk, Cone, Csg>;
 
 // A shape placed in the world, optionally through an affine transform (worldFromObject), with what
 // the renderer needs to shade it. The seed's Geometry: shape + material + emission colour.
@@ -234,6 +253,15 @@ class Primitive {
   const Transform* worldFromObject() const { return worldFromObject_.get(); }
   std::uint32_t materialIndex() const { return materialIndex_; }
   const Color& emission() const { return emission_; }
+  // The material and emission of the surface a hit is on: a csg operand's (ShapeHit::part), else
+  // the primitive's own.
+  std::uint32_t materialIndexAt(std::uint32_t part) const;
+  const Color& emissionAt(std::uint32_t part) const;
+  // The csg shape, or null.
+  const Csg* csg() const { return std::get_if<Csg>(&shape_); }
+  // For a csg: the product of its operands' transmission over every crossing of its surface in
+  // (tMin, tMax) (csgTransmittance); the ray in world space.
+  Color csgTransmittance(const Ray& ray, double tMin, double tMax) const;
 
  private:
   // What a ray query reads comes first. The transform lives out of line, shared between copies:

@@ -10,6 +10,8 @@
 #include <utility>
 
 #include "glint/core/spawn.h"
+#include "glint/geometry/csg.h"
+#include "glint/geometry/object_space.h"
 #include "glint/geometry/shape.h"
 #include "glint/geometry/watertight_triangle.h"
 
@@ -919,8 +921,8 @@ Bounds3 Disk::bounds() const { return diskBounds(center, toVec(normal), radius);
 Normal3 Disk::normalAt(const Point3&) const { return normal; }
 
 // ------------------------------------------------------------------------------------- Primitive
-
-namespace {
+// (requireInvertibleAffine, worldPointError and objectRayOf are shared with csg.cpp through
+// object_space.h.)
 
 // An affine transform whose linear part has a finite, non-zero determinant (and a finite inverse),
 // so object-space rays keep non-zero directions and t means the same in both spaces.
@@ -990,8 +992,6 @@ Ray objectRayOf(const Transform& worldFromObject, const Ray& r) {
        m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z}};
 }
 
-}  // namespace
-
 Primitive::Primitive(Shape shape, std::uint32_t materialIndex, const Color& emission,
                      std::optional<Transform> worldFromObject)
     : shape_(std::move(shape)), emission_(emission), materialIndex_(materialIndex) {
@@ -1048,6 +1048,23 @@ int Primitive::crossings(const Ray& ray, double tMin, double tMax) const {
   }
   const Ray objectRay = objectRayOf(*worldFromObject_, ray);
   return std::visit([&](const auto& s) { return s.crossings(objectRay, tMin, tMax); }, shape_);
+}
+
+std::uint32_t Primitive::materialIndexAt(std::uint32_t part) const {
+  const Csg* c = csg();
+  return c != nullptr ? c->tree->operands[part].materialIndex : materialIndex_;
+}
+
+const Color& Primitive::emissionAt(std::uint32_t part) const {
+  const Csg* c = csg();
+  return c != nullptr ? c->tree->operands[part].emission : emission_;
+}
+
+Color Primitive::csgTransmittance(const Ray& ray, double tMin, double tMax) const {
+  const Csg& c = std::get<Csg>(shape_);
+  return worldFromObject_
+             ? glint::csgTransmittance(c, objectRayOf(*worldFromObject_, ray), tMin, tMax)
+             : glint::csgTransmittance(c, ray, tMin, tMax);
 }
 
 }  // namespace glint

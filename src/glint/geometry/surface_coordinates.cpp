@@ -2,6 +2,8 @@
 // and the mesh tangent frames.
 #include "glint/geometry/surface_coordinates.h"
 
+#include "glint/geometry/csg.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -162,7 +164,8 @@ void planeAxes(const Vec3& n, Vec3& uAxis, Vec3& vAxis) {
   vAxis = cross(n, uAxis);
 }
 
-SurfaceCoordinates surfaceCoordinates(const Shape& shape, const Point3& p) {
+SurfaceCoordinates surfaceCoordinates(const Shape& shape, const Point3& p, std::uint32_t part) {
+  if (const auto* s = std::get_if<Csg>(&shape)) return csgSurfaceCoordinates(*s, part, p);
   if (const auto* s = std::get_if<Sphere>(&shape)) return sphereCoordinates(*s, p);
   if (const auto* s = std::get_if<Plane>(&shape)) {
     Vec3 uAxis;

@@ -44,8 +44,9 @@ void planeAxes(const Vec3& n, Vec3& uAxis, Vec3& vAxis);
 //     from the axis' tip; v = distance along the axis from origin, in scene units;
 //   cylinder: the side as the tube with v = 0 at the base and 1 at the top; each cap as a disk
 //     with the cap's outward normal;
-//   box: each face its own [0, 1]² with planeAxes of the face's outward normal.
-SurfaceCoordinates surfaceCoordinates(const Shape& shape, const Point3& p);
+//   box: each face its own [0, 1]² with planeAxes of the face's outward normal;
+//   csg: those of its operand `part` (ShapeHit::part; csgSurfaceCoordinates in csg.h).
+SurfaceCoordinates surfaceCoordinates(const Shape& shape, const Point3& p, std::uint32_t part = 0);
 
 // (u, v) of a mesh triangle at point p (world space) from the mesh's per-vertex uvs, or the
 // barycentric coordinates of its second and third corner when the mesh has none. Smooth meshes

@@ -58,7 +58,7 @@ SurfaceFrame frameAt(const Scene& scene, const Hit& hit) {
   const Primitive& primitive = scene.primitives()[hit.primitive];
   const Transform* worldFromObject = primitive.worldFromObject();
   f.objectPoint = worldFromObject ? worldFromObject->inverse()(hit.point) : hit.point;
-  f.world = surfaceCoordinates(primitive.shape(), f.objectPoint);
+  f.world = surfaceCoordinates(primitive.shape(), f.objectPoint, hit.part);
   f.objectDpdu = f.world.dpdu;
   f.objectDpdv = f.world.dpdv;
   if (worldFromObject) {

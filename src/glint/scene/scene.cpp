@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "glint/core/spawn.h"
+#include "glint/geometry/csg.h"
 
 namespace glint {
 
@@ -76,7 +77,26 @@ Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materia
   std::vector<Color> transmission;
   transmission.reserve(parts.primitives.size());
   for (std::size_t i = 0; i < parts.primitives.size(); ++i) {
-    transmission.push_back(checkMaterial("primitive", i, parts.primitives[i].materialIndex()));
+    Primitive& primitive = parts.primitives[i];
+    const Color kt = checkMaterial("primitive", i, primitive.materialIndex());
+    const Csg* csg = primitive.csg();
+    if (csg == nullptr) {
+      transmission.push_back(kt);
+      continue;
+    }
+    // A csg's operands carry their own kt; the primitive's says only whether any dims a shadow ray.
+    std::vector<Color> operandTransmission;
+    bool clear = true;
+    for (const CsgOperand& operand : csg->tree->operands) {
+      operandTransmission.push_back(
+          checkMaterial("csg operand of primitive", i, operand.materialIndex));
+      clear = clear && operandTransmission.back() == Color(1);
+    }
+    const Transform* transform = primitive.worldFromObject();
+    primitive = Primitive(withCsgTransmission(*csg, operandTransmission), primitive.materialIndex(),
+                          primitive.emission(),
+                          transform ? std::optional<Transform>(*transform) : std::nullopt);
+    transmission.push_back(clear ? Color(1) : Color());
   }
   std::vector<Color> meshTransmission;
   meshTransmission.reserve(parts.meshes.size());

@@ -114,12 +114,14 @@ class Scene {
     return materials_[aggregate_.primitives()[primitive].materialIndex()];
   }
   // The material and the emission of what a ray hit: its primitive's, or its mesh's.
+  // (A csg's operands may each have their own: Primitive::materialIndexAt(hit.part).)
   const Material& materialOf(const Hit& hit) const {
-    return materials_[hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].materialIndex()
-                                          : aggregate_.meshes()[hit.mesh].materialIndex];
+    return materials_[hit.mesh == kNoMesh
+                          ? aggregate_.primitives()[hit.primitive].materialIndexAt(hit.part)
+                          : aggregate_.meshes()[hit.mesh].materialIndex];
   }
   const Color& emissionOf(const Hit& hit) const {
-    return hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].emission()
+    return hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].emissionAt(hit.part)
                                : aggregate_.meshes()[hit.mesh].emission;
   }
   const std::vector<Texture>& textures() const { return textures_; }
