@@ -96,7 +96,10 @@ std::optional<Csg> readOperand(const ValueReader& reader, ValueId value, ValueId
   const bool isCsg = type->value == "csg";
   params.declare(isCsg ? kCsgKeys : factory->keys);
   params.declare({"material", "emission", "transform"});
-  if (const auto own = services.material(params, path)) material = *own;
+  if (const auto own = services.material(params, path)) {
+    material = *own;
+    if (services.emissionTexture) emission = Color();
+  }
   if (params.has("emission")) {
     if (const auto own = readColor(params, "emission", services.encoding)) emission = *own;
   }

@@ -28,6 +28,9 @@ struct CsgServices {
   // null after an error (reported).
   std::function<std::shared_ptr<const MeshFile>(ParameterDictionary&, const MeshRequest&)> mesh;
   Encoding encoding = Encoding::Srgb;  // of `emission` colours
+  // The csg's emission is a texture carried by its material (the emission constant is then 1): an
+  // operand with a material of its own does not inherit it.
+  bool emissionTexture = false;
 };
 
 // The object keys of `csg` besides material, emission and transform.

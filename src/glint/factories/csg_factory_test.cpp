@@ -66,6 +66,23 @@ TEST(CsgFactory, BuildsOnePrimitiveWithTheOperandsMaterialsAndTransforms) {
   EXPECT_FALSE(s.intersect(Ray{{0, 0, 0}, {0, 0, -1}}, kInfinity, hit) && hit.t < 5.9);
 }
 
+TEST(CsgFactory, AnEmissionTextureGlowsOnOperandsWithoutAMaterialOfTheirOwn) {
+  LoadedScene loaded = loadSceneFromString(
+      scene("  - type: csg\n"
+            "    operation: union\n"
+            "    emission: {type: checker, colors: [[1, 1, 1], [0, 0, 0]], scale: 1}\n"
+            "    operands:\n"
+            "      - {type: sphere, center: [0, 0, 0], radius: 1}\n"
+            "      - {type: sphere, center: [3, 0, 0], radius: 1, material: red}\n"),
+      "test.yaml");
+  const Scene s(std::move(loaded.parts));
+  const CsgTree& tree = *s.primitives().at(0).csg()->tree;
+  EXPECT_EQ(tree.operands[0].emission, Color(1));  // × the texture, in the csg's material
+  EXPECT_NE(s.materials()[tree.operands[0].materialIndex].textures, kUntextured);
+  EXPECT_EQ(tree.operands[1].emission, Color(0));
+  EXPECT_EQ(s.materials()[tree.operands[1].materialIndex].kd, Color(1, 0, 0));
+}
+
 TEST(CsgFactory, AClosedInlineMeshIsAnOperand) {
   LoadedScene loaded = loadSceneFromString(
       scene("  - type: csg\n"

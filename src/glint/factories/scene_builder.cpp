@@ -315,7 +315,7 @@ class Builder {
           return resolveMaterial(p, owner).index;
         },
         [this](ParameterDictionary& p, const MeshRequest& request) { return loadMesh(p, request); },
-        ctx_.encoding};
+        ctx_.encoding, emissionTexture.has_value()};
     std::optional<Csg> csg = readCsg(params, "csg", material.index, emission, services);
     params.finish();
     if (!csg || params.errors() != 0 || !transform.ok) return;

@@ -402,7 +402,7 @@ TEST(SceneParser, UnknownTypesListTheKnownOnes) {
                  "unknown light type 'laser'; expected one of: directional, point, spot, area");
   expectOneError(std::string(kMinimal) + "objects:\n  - {type: sphre}\n", 4, 12,
                  "unknown object type 'sphre'; expected one of: sphere, plane, triangle, polygon, "
-                 "rectangle, quadrangle, tube, cylinder, box, disk, cone, mesh (did you mean "
+                 "rectangle, quadrangle, tube, cylinder, box, disk, cone, mesh, csg (did you mean "
                  "'sphere'?)");
   expectOneError(std::string(kMinimal) + "lights:\n  - {type: ambient}\n", 4, 12,
                  "top-level key 'ambient'");
