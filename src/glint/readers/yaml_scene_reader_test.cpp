@@ -849,7 +849,7 @@ TEST_F(IncludeFiles, CyclesMissingFilesAndSceneKeysAreErrorsAtTheirPlace) {
                 "a.yaml:1:19: cannot include 'missing.yaml': No such file or directory",
                 "b.yaml:1:11: include cycle: a.yaml -> b.yaml -> a.yaml",
                 "b.yaml:3:1: 'objects' belongs in the scene file: an included file holds "
-                "textures, materials and further includes only"}));
+                "textures, materials, groups and further includes only"}));
   write("c.yaml", std::string("include: [list.yaml, broken.yaml, {a: 1}]\n") + kCameraImage);
   write("list.yaml", "- a\n");
   write("broken.yaml", "materials: {m: {kd: [1, 2}\n");

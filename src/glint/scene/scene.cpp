@@ -1,12 +1,21 @@
 // Scene construction: camera from the image size, material validation, the frozen aggregate.
 #include "glint/scene/scene.h"
 
+#include "glint/scene/scene_instances.h"
+
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <variant>
 
 namespace glint {
+
+Color shadowTransmission(const Material& material, const std::vector<Texture>& textures,
+                         const std::vector<MaterialTextures>& bindings) {
+  if (material.textures == kUntextured) return material.kt;
+  const TextureId kt = bindings[material.textures].kt;
+  return kt == kNoTexture ? material.kt : material.kt * meanOf(textures[kt]);
+}
 
 namespace {
 
@@ -15,15 +24,6 @@ CameraSpec cameraSpecFor(const SceneParts& parts) {
   spec.imageWidth = parts.image.width;
   spec.imageHeight = parts.image.height;
   return spec;
-}
-
-// The factor a shadow ray keeps crossing a surface of `material`: kt, times the mean of kt's
-// texture (a shadow ray has no (u, v) to look one up at).
-Color shadowTransmission(const Material& material, const std::vector<Texture>& textures,
-                         const std::vector<MaterialTextures>& bindings) {
-  if (material.textures == kUntextured) return material.kt;
-  const TextureId kt = bindings[material.textures].kt;
-  return kt == kNoTexture ? material.kt : material.kt * meanOf(textures[kt]);
 }
 
 // Every material's texture bindings and texture ids must be in range.
@@ -60,7 +60,10 @@ void checkTextures(const SceneParts& parts) {
 // a shadow ray keeps per crossing.
 Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materials,
                          const std::vector<Texture>& textures,
-                         const std::vector<MaterialTextures>& bindings) {
+                         const std::vector<MaterialTextures>& bindings,
+                         std::vector<GroupMaterialTakers>& takers) {
+  std::shared_ptr<const InstanceSet> instances =
+      buildInstanceSet(parts, materials, textures, bindings, takers);
   const auto checkMaterial = [&](const char* what, std::size_t i, std::uint32_t material) {
     if (material >= materials.size()) {
       throw std::invalid_argument(std::string(what) + " " + std::to_string(i) + " uses material " +
@@ -80,7 +83,7 @@ Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materia
     meshTransmission.push_back(checkMaterial("mesh", m, parts.meshes[m].materialIndex));
   }
   return Aggregate(std::move(parts.primitives), std::move(transmission), std::move(parts.meshes),
-                   std::move(meshTransmission), parts.acceleration);
+                   std::move(meshTransmission), parts.acceleration, std::move(instances));
 }
 
 }  // namespace
@@ -101,7 +104,8 @@ Scene::Scene(SceneParts parts)
       camera_(cameraSpecFor(parts)),
       image_(std::move(parts.image)),
       render_(parts.render),
-      aggregate_(buildAggregate(parts, materials_, textures_, materialTextures_)),
+      aggregate_(
+          buildAggregate(parts, materials_, textures_, materialTextures_, groupTakesMaterial_)),
       emitterSampler_(render_.integrator == Integrator::Path
                           ? EmitterSampler::make(aggregate_.primitives(), aggregate_.meshes(),
                                                  materials_, materialTextures_)
@@ -124,6 +128,16 @@ Scene::Scene(SceneParts parts)
         break;
     }
   }
+}
+
+std::uint32_t Scene::instancedMaterialIndex(const Hit& hit) const {
+  const Instance& in = aggregate_.instances()->instance(hit.instance);
+  const GroupMaterialTakers& takers = groupTakesMaterial_[in.group];
+  const bool takes =
+      hit.mesh == kNoMesh ? takers.primitives[hit.primitive] != 0 : takers.meshes[hit.mesh] != 0;
+  if (takes && in.material != kNoMaterialOverride) return in.material;
+  return hit.mesh == kNoMesh ? aggregate_.primitiveOf(hit).materialIndex()
+                             : aggregate_.meshOf(hit).materialIndex;
 }
 
 }  // namespace glint

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "glint/accel/aggregate.h"
+#include "glint/accel/instances.h"
 #include "glint/core/color.h"
 #include "glint/scene/camera.h"
 #include "glint/scene/emitters.h"
@@ -77,12 +78,33 @@ struct RenderSettings {
   PathLightSampling lightSampling = PathLightSampling::Mis;
 };
 
+// A group of the scene file's `groups` (DESIGN.md §11), in the group's own space, placed by
+// SceneParts::instances. Material indices point into SceneParts::materials.
+struct GroupParts {
+  std::vector<Primitive> primitives;
+  std::vector<TriangleMesh> meshes;
+  // Per primitive and per mesh: 1 when it was written without a `material`, so that an instance's
+  // material replaces it; empty means all 0.
+  std::vector<std::uint8_t> primitiveTakesMaterial;
+  std::vector<std::uint8_t> meshTakesMaterial;
+};
+
+// Of a built group: which primitives and meshes take an instance's material (1) or keep theirs.
+struct GroupMaterialTakers {
+  std::vector<std::uint8_t> primitives;
+  std::vector<std::uint8_t> meshes;
+};
+
 // Everything needed to build a Scene. The scene builder fills this from a scene file; programs may
 // fill it directly. Primitive material indices point into `materials`.
 struct SceneParts {
   std::string name;
   std::vector<Primitive> primitives;
   std::vector<TriangleMesh> meshes;  // mesh material indices point into `materials`
+  std::vector<GroupParts> groups;    // what `instances` place
+  // Instance::group indexes `groups`; Instance::material is a material index or
+  // kNoMaterialOverride.
+  std::vector<Instance> instances;
   Acceleration acceleration = Acceleration::Bvh;
   std::vector<Material> materials{Material{}};     // index 0: the default material
   std::vector<Texture> textures;                   // MaterialTextures' TextureIds index these
@@ -114,13 +136,17 @@ class Scene {
   }
   // The material and the emission of what a ray hit: its primitive's, or its mesh's.
   const Material& materialOf(const Hit& hit) const {
+    if (hit.instance != kNoInstance) return materials_[instancedMaterialIndex(hit)];
     return materials_[hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].materialIndex()
                                           : aggregate_.meshes()[hit.mesh].materialIndex];
   }
   const Color& emissionOf(const Hit& hit) const {
-    return hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].emission()
-                               : aggregate_.meshes()[hit.mesh].emission;
+    return hit.mesh == kNoMesh ? aggregate_.primitiveOf(hit).emission()
+                               : aggregate_.meshOf(hit).emission;
   }
+  // The mesh (hit.mesh != kNoMesh) or primitive a hit is on, inside an instance's group too.
+  const TriangleMesh& meshOf(const Hit& hit) const { return aggregate_.meshOf(hit); }
+  const Primitive& primitiveOf(const Hit& hit) const { return aggregate_.primitiveOf(hit); }
   const std::vector<Texture>& textures() const { return textures_; }
   const std::vector<MaterialTextures>& materialTextures() const { return materialTextures_; }
   // Whether any material or the background has a texture: the renderer then tracks ray
@@ -159,6 +185,10 @@ class Scene {
   }
 
  private:
+  // The material of a hit on an instance: the instance's own for group objects written without
+  // one, else the object's.
+  std::uint32_t instancedMaterialIndex(const Hit& hit) const;
+
   std::string name_;
   std::vector<Material> materials_;
   std::vector<Texture> textures_;
@@ -172,6 +202,9 @@ class Scene {
   Camera camera_;
   ImageSettings image_;
   RenderSettings render_;
+  // Per group the Aggregate of instances() holds (instances.h): which of its primitives and meshes
+  // take an instance's material (GroupParts). Before aggregate_: filled while it is built.
+  std::vector<GroupMaterialTakers> groupTakesMaterial_;
   Aggregate aggregate_;
   std::shared_ptr<const EmitterSampler> emitterSampler_;  // after aggregate_: built from it
   std::vector<LightSurface> lightSurfaces_;
