@@ -61,8 +61,8 @@ class Builder {
         }) {
     ctx_.textures = &textures_;
     for (const ObjectFactory& f : objectFactories()) objectTypes_.push_back(f.type);
-    for (const ObjectFactory& f : options_.extraObjectFactories) objectTypes_.push_back(f.type);
     objectTypes_.push_back(kInstanceFactory.type);
+    for (const ObjectFactory& f : options_.extraObjectFactories) objectTypes_.push_back(f.type);
     for (const LightFactory& f : lightFactories()) lightTypes_.push_back(f.type);
   }
 

@@ -400,10 +400,11 @@ TEST(SceneParser, MeshKeyErrors) {
 TEST(SceneParser, UnknownTypesListTheKnownOnes) {
   expectOneError(std::string(kMinimal) + "lights:\n  - {type: laser, position: [0, 0, 0]}\n", 4, 12,
                  "unknown light type 'laser'; expected one of: directional, point, spot, area");
-  expectOneError(std::string(kMinimal) + "objects:\n  - {type: sphre}\n", 4, 12,
-                 "unknown object type 'sphre'; expected one of: sphere, plane, triangle, polygon, "
-                 "rectangle, quadrangle, tube, cylinder, box, disk, cone, mesh (did you mean "
-                 "'sphere'?)");
+  expectOneError(
+      std::string(kMinimal) + "objects:\n  - {type: sphre}\n", 4, 12,
+      "unknown object type 'sphre'; expected one of: sphere, plane, triangle, polygon, "
+      "rectangle, quadrangle, tube, cylinder, box, disk, cone, mesh, instance (did you mean "
+      "'sphere'?)");
   expectOneError(std::string(kMinimal) + "lights:\n  - {type: ambient}\n", 4, 12,
                  "top-level key 'ambient'");
   expectOneError(std::string(kMinimal) + "image2: {}\n", 3, 1, "did you mean 'image'?");
