@@ -181,6 +181,22 @@ TEST(Instancing, SolidTexturesFollowTheInstance) {
   EXPECT_EQ(bytesOf(actual), bytesOf(expected));
 }
 
+TEST(Instancing, AGlowingInstanceIsLightEnoughForTheUnlitSceneWarning) {
+  const std::string base = std::string(testing::kMinimal) +
+                           "groups:\n  lamp: [{type: sphere, center: [0, 0, 0], radius: 1, "
+                           "emission: [1, 1, 1]}]\n  ball: [{type: sphere, center: [0, 0, 0], "
+                           "radius: 1}]\nobjects:\n";
+  EXPECT_TRUE(loadSceneFromString(base + "  - {type: instance, group: lamp}\n", "test.yaml")
+                  .warnings.empty());
+  EXPECT_TRUE(loadSceneFromString(base + "  - {type: instance, group: ball, material: {kr: 1}}\n",
+                                  "test.yaml")
+                  .warnings.empty());
+  const std::vector<Diagnostic> dark =
+      loadSceneFromString(base + "  - {type: instance, group: ball}\n", "test.yaml").warnings;
+  ASSERT_EQ(dark.size(), 1u);
+  EXPECT_THAT(dark[0].message, HasSubstr("every object will render black"));
+}
+
 class IncludedGroups : public ::testing::Test {
  protected:
   void SetUp() override {

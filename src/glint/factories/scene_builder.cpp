@@ -608,7 +608,8 @@ class Builder {
   // Objects shade black without any light, ambient, emission or mirror/glass to show the
   // background; that is almost always a forgotten `lights` or `ambient` section.
   void warnIfUnlit() {
-    if (sink_.hasErrors() || (parts_.primitives.empty() && parts_.meshes.empty()) ||
+    if (sink_.hasErrors() ||
+        (parts_.primitives.empty() && parts_.meshes.empty() && parts_.instances.empty()) ||
         !parts_.lights.empty() || !isBlack(parts_.ambient)) {
       return;
     }
@@ -617,6 +618,22 @@ class Builder {
     }
     for (const TriangleMesh& mesh : parts_.meshes) {
       if (shows(mesh.emission, mesh.materialIndex)) return;
+    }
+    // Instanced objects (with the instances' materials or their own) count as well; each placed
+    // group is looked at once.
+    std::vector<bool> placed(parts_.groups.size(), false);
+    for (const Instance& instance : parts_.instances) {
+      if (instance.material != kNoMaterialOverride && shows(Color(), instance.material)) return;
+      placed[instance.group] = true;
+    }
+    for (std::size_t g = 0; g < parts_.groups.size(); ++g) {
+      if (!placed[g]) continue;
+      for (const Primitive& p : parts_.groups[g].primitives) {
+        if (shows(p.emission(), p.materialIndex())) return;
+      }
+      for (const TriangleMesh& mesh : parts_.groups[g].meshes) {
+        if (shows(mesh.emission, mesh.materialIndex)) return;
+      }
     }
     sink_.warning({d_.files.at(0)->name, 0, 0},
                   "the scene has no lights, no ambient light and no emissive, reflective or "
