@@ -8,7 +8,7 @@
 #   --build-dir DIR  build tree to use (default build/, the release preset's)
 #   --no-build       run what DIR already holds
 #   --only NAMES     comma-separated subset of: ray_throughput, build_memory, bvh_scaling,
-#                    renderer_comparison, adaptive_sampling, path_tracing
+#                    renderer_comparison, adaptive_sampling, path_tracing, instancing
 #
 # Needs Embree 3, Tachyon and POV-Ray (scripts/setup.sh bench installs them). Everything printed is
 # also saved to DIR/bench-results/bench-DATE.txt; the renderer comparison leaves its scenes, logs and
@@ -26,7 +26,7 @@ quick=()
 runs=()
 build_dir=build
 build=1
-only=ray_throughput,build_memory,bvh_scaling,renderer_comparison,adaptive_sampling,path_tracing
+only=ray_throughput,build_memory,bvh_scaling,renderer_comparison,adaptive_sampling,path_tracing,instancing
 while (($#)); do
   case "$1" in
     --quick) quick=(--quick) ;;
@@ -100,6 +100,7 @@ run() {
     --out "$results/renderer_comparison"
   run adaptive_sampling "$bench_bin/adaptive_sampling" "${quick[@]}" "${runs[@]}"
   run path_tracing "$bench_bin/path_tracing" "${quick[@]}" "${runs[@]}"
+  run instancing "$bench_bin/instancing" "${quick[@]}" "${runs[@]}"
   printf '\nuptime: %s\n' "$(uptime)"
 } 2>&1 | tee "$log"
 printf 'bench: results saved to %s\n' "$log" >&2

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "glint/accel/bvh4.h"
@@ -17,6 +18,9 @@
 namespace glint {
 
 inline constexpr std::uint32_t kNoMesh = 0xffffffffu;
+inline constexpr std::uint32_t kNoInstance = 0xffffffffu;
+
+class InstanceSet;  // instances.h: groups placed by transforms (a two-level BVH)
 
 struct Hit {
   double t = 0;           // ray parameter
@@ -31,6 +35,10 @@ struct Hit {
   std::uint32_t mesh = kNoMesh;  // index into the meshes, or kNoMesh for an analytic primitive
   std::uint32_t triangle = 0;    // triangle index within meshes()[mesh] (see meshes())
   std::uint32_t part = 0;        // on a csg primitive: the operand hit (ShapeHit::part)
+  // The instance hit (instances.h), or kNoInstance. On an instance, primitive, mesh and triangle
+  // index its group's Aggregate (InstanceSet::group), not this one; t, the normals, point and
+  // pointError are in world space all the same.
+  std::uint32_t instance = kNoInstance;
 };
 
 // How the Aggregate organises its primitives: a BVH, or none (every ray tests every primitive —
@@ -49,10 +57,12 @@ class Aggregate {
   // position; std::length_error past 2^32 − 1 references or kMaxMeshes meshes.
   // Degenerate triangles (zero area or non-finite vertices) are left out: they never hit.
   // Large inputs are built in parallel on the calling oneTBB arena; the result does not depend on
-  // the thread count.
+  // the thread count. `instances` (may be null) are queried with the rest: their hits carry
+  // Hit::instance.
   Aggregate(std::vector<Primitive> primitives, std::vector<Color> primitiveTransmission,
             std::vector<TriangleMesh> meshes = {}, std::vector<Color> meshTransmission = {},
-            Acceleration acceleration = Acceleration::Bvh);
+            Acceleration acceleration = Acceleration::Bvh,
+            std::shared_ptr<const InstanceSet> instances = nullptr);
 
   // Closest hit with tMin < t < tMax. The slab tests run in single precision on boxes rounded
   // outward; rays must have finite origins within ±1e38 and no direction component above 1e30 in
@@ -60,6 +70,13 @@ class Aggregate {
   bool intersect(const Ray& ray, double tMin, double tMax, Hit& hit) const;
   // Product of kt over every surface crossing in (tMin, tMax); stops early once it is black.
   Color transmittance(const Ray& ray, double tMin, double tMax) const;
+
+  // The instances queried with this aggregate's own primitives and meshes, or null.
+  const InstanceSet* instances() const { return instances_.get(); }
+  // The mesh a hit with hit.mesh != kNoMesh is on, and the primitive of one with kNoMesh, in this
+  // aggregate or in the hit instance's group.
+  const TriangleMesh& meshOf(const Hit& hit) const;
+  const Primitive& primitiveOf(const Hit& hit) const;
 
   // The vertex colour at a hit on a mesh that has colors (TriangleMesh::colors), interpolated
   // barycentrically at the hit point.
@@ -70,7 +87,8 @@ class Aggregate {
   // into the tree's leaf order and its degenerate triangles and unused vertices are left out (same
   // values, same winding, same material); Hit::triangle indexes these, not the input order.
   const std::vector<TriangleMesh>& meshes() const { return meshes_; }
-  Bounds3 bounds() const { return bounds_; }  // of the bounded primitives and the mesh triangles
+  // Of the bounded primitives and the mesh triangles (and the bounded instances).
+  Bounds3 bounds() const { return bounds_; }
   Acceleration acceleration() const { return acceleration_; }
   // Mesh triangles in the structure (the degenerate ones left out).
   std::size_t triangleCount() const { return triangleCount_; }
@@ -81,6 +99,8 @@ class Aggregate {
  private:
   bool intersectBruteForce(const Ray& ray, double tMin, double tMax, Hit& hit) const;
   Color transmittanceBruteForce(const Ray& ray, double tMin, double tMax) const;
+  Color transmittanceOwn(const Ray& ray, double tMin, double tMax) const;  // without instances
+  bool intersectInstances(const Ray& ray, double tMin, double tMax, Hit& hit) const;
   // normal: the triangle's unnormalised geometric normal (p1 − p0) × (p2 − p0).
   void finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle, const WatertightHit& candidate,
                          const Vec3& normal, Hit& hit) const;
@@ -105,6 +125,7 @@ class Aggregate {
   std::size_t triangleCount_ = 0;
   Bounds3 bounds_;
   Acceleration acceleration_ = Acceleration::Bvh;
+  std::shared_ptr<const InstanceSet> instances_;
 };
 
 }  // namespace glint

@@ -332,6 +332,10 @@ int runCheck(const std::string& file) {
   text += fmt::format("objects:   {} ({} bounded, {} unbounded)\n", scene.objects,
                       scene.objects - scene.unboundedObjects, scene.unboundedObjects);
   text += fmt::format("meshes:    {} ({} triangles)\n", scene.meshes, scene.triangles);
+  if (scene.instances > 0) {
+    text += fmt::format("instances: {} of {} groups ({} triangles in the groups)\n",
+                        scene.instances, scene.groups, scene.groupTriangles);
+  }
   text += fmt::format("lights:    {}\n", lightsText(scene));
   text += fmt::format("materials: {}\n", scene.materials);
   text += fmt::format("bounds:    {}\n", boundsText(scene));

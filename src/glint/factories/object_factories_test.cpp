@@ -89,7 +89,8 @@ TEST(ObjectFactories, TheAddedShapeGetsEveryMessageOfTheBuiltInOnes) {
   EXPECT_EQ(errors[0].message, "cube is missing required key 'center'");
   errors = errorsOf("{type: cub, size: 1}");
   ASSERT_EQ(errors.size(), 1u);
-  EXPECT_THAT(errors[0].message, HasSubstr("disk, cone, mesh, csg, cube (did you mean 'cube'?)"));
+  EXPECT_THAT(errors[0].message,
+              HasSubstr("disk, cone, mesh, csg, instance, cube (did you mean 'cube'?)"));
   // Transforms, materials and emission come with every object type.
   BuildResult moved = buildWithCube(std::string(kScene) +
                                     "  - {type: cube, center: [0, 0, 0], size: 1, emission: "

@@ -39,6 +39,10 @@ constexpr std::size_t kEntitiesPerPoll = 1024;
 // Objects that reflect no light get a warning each up to this many; the rest are counted.
 constexpr std::size_t kMaxDarkObjectWarnings = 5;
 
+// `type: instance` is listed and its keys checked like the shapes' types, but the builder places
+// it itself (buildInstance): it makes no geometry of its own.
+const ObjectFactory kInstanceFactory{"instance", {"group"}, nullptr};
+
 // What an object's `material` key chose.
 struct MaterialChoice {
   std::uint32_t index = 0;  // into SceneParts::materials; 0 = the default material
@@ -60,6 +64,7 @@ class Builder {
     ctx_.textures = &textures_;
     for (const ObjectFactory& f : objectFactories()) objectTypes_.push_back(f.type);
     objectTypes_.push_back(csgFactory_.type);
+    objectTypes_.push_back(kInstanceFactory.type);
     for (const ObjectFactory& f : options_.extraObjectFactories) objectTypes_.push_back(f.type);
     for (const LightFactory& f : lightFactories()) lightTypes_.push_back(f.type);
   }
@@ -91,6 +96,9 @@ class Builder {
     }
     for (const Entity& e : d_.entities) {
       if (e.kind == EntityKind::MaterialEntity) buildNamedMaterial(e);
+    }
+    for (const Entity& e : d_.entities) {
+      if (e.kind == EntityKind::GroupEntity) buildGroup(e);
     }
     // Sized once: a Primitive is a few hundred bytes, and growing the array by doubling would copy
     // them all again and again.
@@ -231,9 +239,94 @@ class Builder {
     }
   }
 
-  void buildObject(const Entity& e) {
+  // --- groups and instances (DESIGN.md §11) ---------------------------------------------------
+
+  // A named group: its objects built as `objects` entries are, into parts_.groups in the group's
+  // own space. A name defined twice is an error naming both places (the file too when the first
+  // is in another one).
+  void buildGroup(const Entity& e) {
     const ValueReader reader = readerOf(e);
-    const std::string path = fmt::format("objects[{}]", e.index);
+    const ValueTree& tree = reader.tree();
+    const std::string name(tree.scalar(e.name));
+    if (const auto it = groupIndex_.find(name); it != groupIndex_.end()) {
+      const auto& [firstFile, first] = groupWhere_[it->second];
+      const std::string where =
+          firstFile == e.file ? fmt::format("line {}, column {}", first.line, first.column)
+                              : fmt::format("{}:{}:{}", escapeForMessage(d_.files[firstFile]->name),
+                                            first.line, first.column);
+      reader.error(e.name, fmt::format("duplicate group '{}': defined twice (first at {})",
+                                       escapeForMessage(name), where));
+      return;
+    }
+    const auto index = static_cast<std::uint32_t>(parts_.groups.size());
+    groupIndex_.emplace(name, index);
+    groupWhere_.push_back({e.file, tree.position(e.name)});
+    parts_.groups.emplace_back();
+    if (tree.isNull(e.value)) return;  // `chair:` with nothing under it: an empty group
+    if (!tree.isList(e.value)) {
+      reader.error(e.value, fmt::format("groups.{}: expected a list of objects, got {}",
+                                        escapeForMessage(name), reader.describe(e.value)));
+      return;
+    }
+    for (std::size_t i = 0; i < tree.size(e.value); ++i) {
+      Entity member;
+      member.kind = EntityKind::ObjectEntity;
+      member.file = e.file;
+      member.index = static_cast<std::uint32_t>(i);
+      member.value = tree.item(e.value, i);
+      member.place = member.value;
+      if (tree.isMap(member.value)) member.type = typeValue(d_.fileOf(e), member.value);
+      group_ = &parts_.groups[index];
+      buildObject(member, fmt::format("groups.{}[{}]", escapeForMessage(name), i));
+      group_ = nullptr;
+    }
+  }
+
+  // `type: instance`: a group placed with the object's transform; its material replaces the
+  // materials of the group's objects written without one. Instances inside groups are refused
+  // (two levels: groups hold shapes and meshes, `objects` places groups), so no group can
+  // instance itself.
+  void buildInstance(ParameterDictionary& params, const std::string& path,
+                     const MaterialChoice& material, const TransformResult& transform) {
+    const auto group = params.text("group", Presence::Required);
+    if (group_ != nullptr) {
+      params.error(params.find("type")->where,
+                   fmt::format("{}: an instance cannot be inside a group (instancing has two "
+                               "levels: groups hold shapes and meshes, objects place groups)",
+                               path));
+      return;
+    }
+    if (!group) return;
+    const auto it = groupIndex_.find(group->value);
+    if (it == groupIndex_.end()) {
+      std::vector<std::string> names;
+      for (const auto& [n, index] : groupIndex_) names.push_back(n);
+      std::string hint = didYouMean(group->value, names);
+      if (hint.empty()) {
+        hint = names.empty() ? "; no groups are defined"
+                             : fmt::format("; defined: {}", fmt::join(names, ", "));
+      }
+      params.error(group->where, fmt::format("instance.group: undefined group '{}'{}",
+                                             escapeForMessage(group->value), hint));
+      return;
+    }
+    if (params.errors() != 0 || !transform.ok) return;
+    try {
+      const Transform* worldFromGroup =
+          transform.worldFromObject ? &*transform.worldFromObject : nullptr;
+      parts_.instances.push_back(makeInstance(
+          worldFromGroup, it->second, material.given ? material.index : kNoMaterialOverride));
+    } catch (const std::invalid_argument& error) {
+      params.error(params.find("transform")->where,
+                   fmt::format("instance.transform: {}", error.what()));
+    }
+  }
+
+  void buildObject(const Entity& e) { buildObject(e, fmt::format("objects[{}]", e.index)); }
+
+  // path: how messages name the entry ("objects[3]", "groups.chair[0]").
+  void buildObject(const Entity& e, const std::string& path) {
+    const ValueReader reader = readerOf(e);
     if (!reader.tree().isMap(e.value)) {
       reader.error(e.place, fmt::format("{}: expected a mapping with a 'type' (sphere, plane, "
                                         "triangle, ...), got {}",
@@ -242,8 +335,9 @@ class Builder {
     }
     const ObjectFactory* factory = factoryOf<ObjectFactory>(
         reader, e, "object", path, objectTypes_, [this](std::string_view type) {
-          return type == csgFactory_.type ? &csgFactory_
-                                          : findObjectFactory(type, options_.extraObjectFactories);
+          if (type == csgFactory_.type) return &csgFactory_;
+          if (type == kInstanceFactory.type) return &kInstanceFactory;
+          return findObjectFactory(type, options_.extraObjectFactories);
         });
     if (factory == nullptr) {
       // Without a type the keys cannot be checked; duplicates still are.
@@ -255,6 +349,14 @@ class Builder {
     params.declareHidden("type");
     params.find("type");
     params.declare(factory->keys);
+    if (type == "instance") {
+      params.declare({"material", "transform"});  // no emission: its objects have their own
+      const MaterialChoice material = resolveMaterial(params, type);
+      const TransformResult transform = readTransform(params, type);
+      buildInstance(params, path, material, transform);
+      params.finish();
+      return;
+    }
     params.declare({"material", "emission", "transform"});
 
     MaterialChoice material = resolveMaterial(params, type);
@@ -295,6 +397,13 @@ class Builder {
     }
     if (emissionTexture) material.index = withEmissionTexture(material.index, *emissionTexture);
     try {
+      if (group_ != nullptr) {
+        group_->primitives.emplace_back(std::move(std::get<Shape>(*geometry)), material.index,
+                                        emission.value_or(Color()), transform.worldFromObject);
+        group_->primitiveTakesMaterial.push_back(
+            static_cast<std::uint8_t>(material.given || emissionTexture ? 0 : 1));
+        return;
+      }
       parts_.primitives.emplace_back(std::move(std::get<Shape>(*geometry)), material.index,
                                      emission.value_or(Color()), transform.worldFromObject);
       objectPlaces_.push_back({e.file, e.value, false});
@@ -320,6 +429,15 @@ class Builder {
     params.finish();
     if (!csg || params.errors() != 0 || !transform.ok) return;
     try {
+      if (group_ != nullptr) {
+        // In a group: an instance's material covers a csg written without one (all its
+        // operands).
+        group_->primitives.emplace_back(std::move(*csg), material.index, emission,
+                                        transform.worldFromObject);
+        group_->primitiveTakesMaterial.push_back(
+            static_cast<std::uint8_t>(material.given || emissionTexture ? 0 : 1));
+        return;
+      }
       parts_.primitives.emplace_back(std::move(*csg), material.index, emission,
                                      transform.worldFromObject);
       objectPlaces_.push_back({e.file, e.value, false});
@@ -448,6 +566,9 @@ class Builder {
       partMaterial.push_back(index);
       anyUv = anyUv || needsUv(index);
     }
+    // In a group, a mesh written without a material takes its instances' (which may be textured).
+    const bool takesMaterial = group_ != nullptr && !material.given && !emissionTexture;
+    anyUv = anyUv || takesMaterial;
     std::vector<TriangleMesh> meshes =
         instantiateMesh(*file, worldFromFile, request.smooth, options_.cancel, anyUv);
     const auto objectTransform =
@@ -458,10 +579,15 @@ class Builder {
       mesh.emission = emission.value_or(material.given ? Color() : own.emission);
       mesh.materialIndex = partMaterial[k];
       mesh.worldFromObject = objectTransform;
-      if (!needsUv(mesh.materialIndex)) {
+      if (!needsUv(mesh.materialIndex) && !takesMaterial) {
         std::vector<Point2>().swap(mesh.uvs);
       } else if (needsTangents(mesh.materialIndex)) {
         computeMeshTangents(mesh);
+      }
+      if (group_ != nullptr) {
+        group_->meshes.push_back(std::move(mesh));
+        group_->meshTakesMaterial.push_back(static_cast<std::uint8_t>(takesMaterial ? 1 : 0));
+        continue;
       }
       parts_.meshes.push_back(std::move(mesh));
     }
@@ -541,7 +667,8 @@ class Builder {
   // Objects shade black without any light, ambient, emission or mirror/glass to show the
   // background; that is almost always a forgotten `lights` or `ambient` section.
   void warnIfUnlit() {
-    if (sink_.hasErrors() || (parts_.primitives.empty() && parts_.meshes.empty()) ||
+    if (sink_.hasErrors() ||
+        (parts_.primitives.empty() && parts_.meshes.empty() && parts_.instances.empty()) ||
         !parts_.lights.empty() || !isBlack(parts_.ambient)) {
       return;
     }
@@ -555,6 +682,22 @@ class Builder {
     }
     for (const TriangleMesh& mesh : parts_.meshes) {
       if (shows(mesh.emission, mesh.materialIndex)) return;
+    }
+    // Instanced objects (with the instances' materials or their own) count as well; each placed
+    // group is looked at once.
+    std::vector<bool> placed(parts_.groups.size(), false);
+    for (const Instance& instance : parts_.instances) {
+      if (instance.material != kNoMaterialOverride && shows(Color(), instance.material)) return;
+      placed[instance.group] = true;
+    }
+    for (std::size_t g = 0; g < parts_.groups.size(); ++g) {
+      if (!placed[g]) continue;
+      for (const Primitive& p : parts_.groups[g].primitives) {
+        if (shows(p.emission(), p.materialIndex())) return;
+      }
+      for (const TriangleMesh& mesh : parts_.groups[g].meshes) {
+        if (shows(mesh.emission, mesh.materialIndex)) return;
+      }
     }
     sink_.warning({d_.files.at(0)->name, 0, 0},
                   "the scene has no lights, no ambient light and no emissive, reflective or "
@@ -622,7 +765,10 @@ class Builder {
   // `csg` has no entry in objectFactories(): its operands need the builder (materials, meshes).
   const ObjectFactory csgFactory_{"csg", kCsgKeys, nullptr};
   std::map<std::uint32_t, std::pair<std::uint32_t, TextPosition>> materialWhere_;  // file, place
-  MeshCache meshCache_;  // each mesh file read once per scene
+  std::map<std::string, std::uint32_t, std::less<>> groupIndex_;    // into parts_.groups
+  std::vector<std::pair<std::uint32_t, TextPosition>> groupWhere_;  // per group: file, place
+  GroupParts* group_ = nullptr;  // while building a group's objects: where they go
+  MeshCache meshCache_;          // each mesh file read once per scene
   std::map<const MeshFile*, std::vector<std::uint32_t>> fileMaterials_;
   std::uint64_t meshTriangles_ = 0;            // in parts_.meshes
   std::vector<ObjectPlace> objectPlaces_;      // per primitive, where its object was written

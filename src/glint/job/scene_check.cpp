@@ -97,6 +97,12 @@ SceneFacts sceneFacts(const Scene& scene) {
     facts.unboundedObjects += primitive.isBounded() ? 0 : 1;
   facts.meshes = scene.meshes().size();
   facts.triangles = scene.aggregate().triangleCount();
+  if (const InstanceSet* instances = scene.aggregate().instances()) {
+    facts.instances = instances->instanceCount();
+    facts.groups = instances->groupCount();
+    for (std::uint32_t g = 0; g < instances->groupCount(); ++g)
+      facts.groupTriangles += instances->group(g).triangleCount();
+  }
   facts.lights = scene.lights().size();
   for (const Light& light : scene.lights())
     facts.areaLights += std::holds_alternative<AreaLight>(light) ? 1 : 0;

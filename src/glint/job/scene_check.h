@@ -28,13 +28,16 @@ struct SceneFacts {
   std::size_t unboundedObjects = 0;  // planes and tubes, outside the BVH
   std::size_t meshes = 0;
   std::uint64_t triangles = 0;
-  std::size_t lights = 0;      // light sources
-  std::size_t areaLights = 0;  // of which area lights (soft shadows)
-  bool ambient = false;        // whether the scene has ambient light
-  std::size_t materials = 0;   // defined by the scene (the built-in default not counted)
-  Bounds3 bounds;              // of the bounded objects; empty when there are none
-  int maxDepth = 0;            // render.max_depth
-  std::uint64_t seed = 0;      // render.seed
+  std::size_t instances = 0;         // `type: instance` objects placed (DESIGN.md §11)
+  std::size_t groups = 0;            // groups they place, as built (one per distinct kt)
+  std::uint64_t groupTriangles = 0;  // mesh triangles in those groups, each counted once
+  std::size_t lights = 0;            // light sources
+  std::size_t areaLights = 0;        // of which area lights (soft shadows)
+  bool ambient = false;              // whether the scene has ambient light
+  std::size_t materials = 0;         // defined by the scene (the built-in default not counted)
+  Bounds3 bounds;                    // of the bounded objects; empty when there are none
+  int maxDepth = 0;                  // render.max_depth
+  std::uint64_t seed = 0;            // render.seed
   Integrator integrator = Integrator::Whitted;  // render.integrator, after --integrator
 };
 

@@ -30,6 +30,7 @@ enum class EntityKind : std::uint8_t {
   ObjectEntity,    // an entry of `objects`; its `type` names its factory
   LightEntity,     // an entry of `lights`; its `type` names its factory
   FogEntity,       // distance fog
+  GroupEntity,     // a named group of `groups` (its value: the list of its objects)
 };
 
 // One text a scene was read from.
@@ -50,7 +51,7 @@ struct Entity {
   ValueId value = kNoValue;  // its mapping of parameters, or its single value (a background colour)
   ValueId place = kNoValue;  // where messages put it: its value, or its key or list when empty
   ValueId type = kNoValue;   // objects, lights: the value of its `type` key, if any
-  ValueId name = kNoValue;   // materials, textures: its name (the key in its section)
+  ValueId name = kNoValue;   // materials, textures, groups: its name (the key in its section)
 };
 
 struct SceneDescription {

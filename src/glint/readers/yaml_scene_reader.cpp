@@ -41,10 +41,10 @@ yaml::Document readYamlFile(const std::filesystem::path& path, const std::string
                             const std::atomic<bool>* cancel);
 
 // The keys of a scene file's top level, and the ones an included file may hold too.
-const std::vector<std::string_view> kSceneKeys = {"name",      "background", "ambient", "fog",
-                                                  "camera",    "image",      "render",  "textures",
-                                                  "materials", "objects",    "lights",  "include"};
-const std::vector<std::string_view> kIncludedKeys = {"include", "textures", "materials"};
+const std::vector<std::string_view> kSceneKeys = {
+    "name",     "background", "ambient", "fog",    "camera",  "image", "render",
+    "textures", "materials",  "objects", "lights", "include", "groups"};
+const std::vector<std::string_view> kIncludedKeys = {"include", "textures", "materials", "groups"};
 
 // The sections of the top-level mapping as entities.
 class TopLevel {
@@ -68,13 +68,14 @@ class TopLevel {
         if (top.isDeclared(key) || !top.has(key)) continue;
         top.error(top.keyPlace(key),
                   fmt::format("'{}' belongs in the scene file: an included file holds textures, "
-                              "materials and further includes only",
+                              "materials, groups and further includes only",
                               key));
         top.markUsed({key});
       }
       includes(top);
       named(top, "textures", "texture", EntityKind::TextureEntity);
       named(top, "materials", "material", EntityKind::MaterialEntity);
+      named(top, "groups", "group", EntityKind::GroupEntity);
       top.finish();
       return;
     }
@@ -94,6 +95,7 @@ class TopLevel {
     section(top, "render", EntityKind::RenderEntity);
     named(top, "textures", "texture", EntityKind::TextureEntity);
     named(top, "materials", "material", EntityKind::MaterialEntity);
+    named(top, "groups", "group", EntityKind::GroupEntity);
     list(top, "objects", "objects", EntityKind::ObjectEntity);
     list(top, "lights", "lights", EntityKind::LightEntity);
     top.finish();

@@ -400,10 +400,11 @@ TEST(SceneParser, MeshKeyErrors) {
 TEST(SceneParser, UnknownTypesListTheKnownOnes) {
   expectOneError(std::string(kMinimal) + "lights:\n  - {type: laser, position: [0, 0, 0]}\n", 4, 12,
                  "unknown light type 'laser'; expected one of: directional, point, spot, area");
-  expectOneError(std::string(kMinimal) + "objects:\n  - {type: sphre}\n", 4, 12,
-                 "unknown object type 'sphre'; expected one of: sphere, plane, triangle, polygon, "
-                 "rectangle, quadrangle, tube, cylinder, box, disk, cone, mesh, csg (did you mean "
-                 "'sphere'?)");
+  expectOneError(
+      std::string(kMinimal) + "objects:\n  - {type: sphre}\n", 4, 12,
+      "unknown object type 'sphre'; expected one of: sphere, plane, triangle, polygon, "
+      "rectangle, quadrangle, tube, cylinder, box, disk, cone, mesh, csg, instance (did you mean "
+      "'sphere'?)");
   expectOneError(std::string(kMinimal) + "lights:\n  - {type: ambient}\n", 4, 12,
                  "top-level key 'ambient'");
   expectOneError(std::string(kMinimal) + "image2: {}\n", 3, 1, "did you mean 'image'?");
@@ -849,7 +850,7 @@ TEST_F(IncludeFiles, CyclesMissingFilesAndSceneKeysAreErrorsAtTheirPlace) {
                 "a.yaml:1:19: cannot include 'missing.yaml': No such file or directory",
                 "b.yaml:1:11: include cycle: a.yaml -> b.yaml -> a.yaml",
                 "b.yaml:3:1: 'objects' belongs in the scene file: an included file holds "
-                "textures, materials and further includes only"}));
+                "textures, materials, groups and further includes only"}));
   write("c.yaml", std::string("include: [list.yaml, broken.yaml, {a: 1}]\n") + kCameraImage);
   write("list.yaml", "- a\n");
   write("broken.yaml", "materials: {m: {kd: [1, 2}\n");

@@ -426,7 +426,7 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
                                          const RayDifferential* differential) {
   TexturedHit textured;
   shadeTexturedHit(ctx.scene, hit, differential, textured);
-  if (hit.mesh != kNoMesh && !ctx.scene.meshes()[hit.mesh].colors.empty()) {
+  if (hit.mesh != kNoMesh && !ctx.scene.meshOf(hit).colors.empty()) {
     const Color tint = ctx.scene.aggregate().vertexColor(hit);
     textured.material.kd *= tint;
     textured.material.ka *= tint;
@@ -477,8 +477,7 @@ Color trace(const TraceContext& ctx, const Ray& ray, const MediumStack& media, i
   Color color;
   if (ctx.textured) {
     color = traceTexturedHit(ctx, ray, hit, here, depth, weight, split, stream, differential);
-  } else if (ctx.vertexColors && hit.mesh != kNoMesh &&
-             !ctx.scene.meshes()[hit.mesh].colors.empty()) {
+  } else if (ctx.vertexColors && hit.mesh != kNoMesh && !ctx.scene.meshOf(hit).colors.empty()) {
     color = traceVertexColouredHit(ctx, ray, hit, here, depth, weight, split, stream);
   } else {
     color = shadeHit(ctx, ray, hit, here, ctx.scene.materialOf(hit), ctx.scene.emissionOf(hit),
@@ -752,7 +751,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
       textured.shadingNormal = hit.shadingNormal;
     }
     Material& material = textured.material;
-    if (ctx.vertexColors && hit.mesh != kNoMesh && !scene.meshes()[hit.mesh].colors.empty()) {
+    if (ctx.vertexColors && hit.mesh != kNoMesh && !scene.meshOf(hit).colors.empty()) {
       const Color tint = scene.aggregate().vertexColor(hit);
       material.kd *= tint;
       material.ka *= tint;

@@ -39,10 +39,12 @@ struct SurfaceFrame {
   Vec3 objectDpdv;
 };
 
-SurfaceFrame frameAt(const Scene& scene, const Hit& hit) {
+// The frame at a hit of the scene's own primitives and meshes, or (local) at a hit inside an
+// instance's group, in the group's space.
+SurfaceFrame frameAtLocal(const Scene& scene, const Hit& hit) {
   SurfaceFrame f;
   if (hit.mesh != kNoMesh) {
-    const TriangleMesh& mesh = scene.meshes()[hit.mesh];
+    const TriangleMesh& mesh = scene.meshOf(hit);
     f.world = surfaceCoordinates(mesh, hit.triangle, hit.point);
     f.objectPoint = hit.point;
     f.objectDpdu = f.world.dpdu;
@@ -55,7 +57,7 @@ SurfaceFrame frameAt(const Scene& scene, const Hit& hit) {
     }
     return f;
   }
-  const Primitive& primitive = scene.primitives()[hit.primitive];
+  const Primitive& primitive = scene.primitiveOf(hit);
   const Transform* worldFromObject = primitive.worldFromObject();
   f.objectPoint = worldFromObject ? worldFromObject->inverse()(hit.point) : hit.point;
   f.world = surfaceCoordinates(primitive.shape(), f.objectPoint, hit.part);
@@ -73,6 +75,25 @@ SurfaceFrame frameAt(const Scene& scene, const Hit& hit) {
     w.dndu = toVec(t(Normal3(w.dndu)));
     w.dndv = toVec(t(Normal3(w.dndv)));
   }
+  return f;
+}
+
+// On an instance: the frame in its group's space at the group-space point, its vectors then
+// carried to world space (normal derivatives by the inverse transpose, as for a transformed
+// primitive). The object point stays the group object's own, so solid textures follow the instance.
+SurfaceFrame frameAt(const Scene& scene, const Hit& hit) {
+  if (hit.instance == kNoInstance) return frameAtLocal(scene, hit);
+  const InstanceSet& instances = *scene.aggregate().instances();
+  Hit local = hit;
+  local.point = instances.groupPoint(hit.instance, hit.point);
+  SurfaceFrame f = frameAtLocal(scene, local);
+  SurfaceCoordinates& w = f.world;
+  w.dpdu = instances.worldVector(hit.instance, w.dpdu);
+  w.dpdv = instances.worldVector(hit.instance, w.dpdv);
+  w.tangent = instances.worldVector(hit.instance, w.tangent);
+  w.bitangent = instances.worldVector(hit.instance, w.bitangent);
+  w.dndu = toVec(instances.worldNormal(hit.instance, Normal3(w.dndu)));
+  w.dndv = toVec(instances.worldNormal(hit.instance, Normal3(w.dndv)));
   return f;
 }
 

@@ -264,10 +264,12 @@ EmitterSampler::Sample EmitterSampler::sample(const Point2& u) const {
 }
 
 double EmitterSampler::areaPdf(const Hit& hit, const Color& emission) const {
+  // Instanced surfaces are not sampled as lights (only reached by BRDF sampling).
   const bool sampled =
-      hit.mesh == kNoMesh
-          ? hit.primitive < sampledPrimitive_.size() && sampledPrimitive_[hit.primitive]
-          : hit.mesh < sampledMesh_.size() && sampledMesh_[hit.mesh];
+      hit.instance == kNoInstance &&
+      (hit.mesh == kNoMesh
+           ? hit.primitive < sampledPrimitive_.size() && sampledPrimitive_[hit.primitive]
+           : hit.mesh < sampledMesh_.size() && sampledMesh_[hit.mesh]);
   return sampled ? luminance(emission) / totalPower_ : 0;
 }
 

@@ -10,8 +10,16 @@
 
 #include "glint/core/spawn.h"
 #include "glint/geometry/csg.h"
+#include "glint/scene/scene_instances.h"
 
 namespace glint {
+
+Color shadowTransmission(const Material& material, const std::vector<Texture>& textures,
+                         const std::vector<MaterialTextures>& bindings) {
+  if (material.textures == kUntextured) return material.kt;
+  const TextureId kt = bindings[material.textures].kt;
+  return kt == kNoTexture ? material.kt : material.kt * meanOf(textures[kt]);
+}
 
 namespace {
 
@@ -20,15 +28,6 @@ CameraSpec cameraSpecFor(const SceneParts& parts) {
   spec.imageWidth = parts.image.width;
   spec.imageHeight = parts.image.height;
   return spec;
-}
-
-// The factor a shadow ray keeps crossing a surface of `material`: kt, times the mean of kt's
-// texture (a shadow ray has no (u, v) to look one up at).
-Color shadowTransmission(const Material& material, const std::vector<Texture>& textures,
-                         const std::vector<MaterialTextures>& bindings) {
-  if (material.textures == kUntextured) return material.kt;
-  const TextureId kt = bindings[material.textures].kt;
-  return kt == kNoTexture ? material.kt : material.kt * meanOf(textures[kt]);
 }
 
 // Every material's texture bindings and texture ids must be in range.
@@ -65,7 +64,10 @@ void checkTextures(const SceneParts& parts) {
 // a shadow ray keeps per crossing.
 Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materials,
                          const std::vector<Texture>& textures,
-                         const std::vector<MaterialTextures>& bindings) {
+                         const std::vector<MaterialTextures>& bindings,
+                         std::vector<GroupMaterialTakers>& takers) {
+  std::shared_ptr<const InstanceSet> instances =
+      buildInstanceSet(parts, materials, textures, bindings, takers);
   const auto checkMaterial = [&](const char* what, std::size_t i, std::uint32_t material) {
     if (material >= materials.size()) {
       throw std::invalid_argument(std::string(what) + " " + std::to_string(i) + " uses material " +
@@ -104,7 +106,7 @@ Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materia
     meshTransmission.push_back(checkMaterial("mesh", m, parts.meshes[m].materialIndex));
   }
   return Aggregate(std::move(parts.primitives), std::move(transmission), std::move(parts.meshes),
-                   std::move(meshTransmission), parts.acceleration);
+                   std::move(meshTransmission), parts.acceleration, std::move(instances));
 }
 
 // Whether a shape bounds a volume with outward normals, so that a ray crossing it enters or leaves
@@ -122,6 +124,9 @@ struct BoundsVolume {
   bool operator()(const Quadrangle&) const { return false; }
   bool operator()(const Disk&) const { return false; }
   bool operator()(const Cone&) const { return false; }
+  // A csg is closed, but its operands may be of several materials: it refracts against the
+  // medium around it, as before nested dielectrics (documented).
+  bool operator()(const Csg&) const { return false; }
 };
 
 // Whether some transparent solid's bounds overlap another transparent object's (solid or flat):
@@ -225,7 +230,8 @@ Scene::Scene(SceneParts parts)
       camera_(cameraSpecFor(parts)),
       image_(std::move(parts.image)),
       render_(parts.render),
-      aggregate_(buildAggregate(parts, materials_, textures_, materialTextures_)),
+      aggregate_(
+          buildAggregate(parts, materials_, textures_, materialTextures_, groupTakesMaterial_)),
       emitterSampler_(render_.integrator == Integrator::Path
                           ? EmitterSampler::make(aggregate_.primitives(), aggregate_.meshes(),
                                                  materials_, materialTextures_)
@@ -296,6 +302,16 @@ void Scene::initialiseMedia() {
   std::stable_sort(leaving.begin(), leaving.end(),
                    [](const Leaving& a, const Leaving& b) { return a.t > b.t; });
   for (const Leaving& l : leaving) cameraMedia_.push(l.medium);
+}
+
+std::uint32_t Scene::instancedMaterialIndex(const Hit& hit) const {
+  const Instance& in = aggregate_.instances()->instance(hit.instance);
+  const GroupMaterialTakers& takers = groupTakesMaterial_[in.group];
+  const bool takes =
+      hit.mesh == kNoMesh ? takers.primitives[hit.primitive] != 0 : takers.meshes[hit.mesh] != 0;
+  if (takes && in.material != kNoMaterialOverride) return in.material;
+  return hit.mesh == kNoMesh ? aggregate_.primitiveOf(hit).materialIndexAt(hit.part)
+                             : aggregate_.meshOf(hit).materialIndex;
 }
 
 }  // namespace glint

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "glint/accel/aggregate.h"
+#include "glint/accel/instances.h"
 #include "glint/core/color.h"
 #include "glint/scene/camera.h"
 #include "glint/scene/emitters.h"
@@ -78,12 +79,33 @@ struct RenderSettings {
   PathLightSampling lightSampling = PathLightSampling::Mis;
 };
 
+// A group of the scene file's `groups` (DESIGN.md §11), in the group's own space, placed by
+// SceneParts::instances. Material indices point into SceneParts::materials.
+struct GroupParts {
+  std::vector<Primitive> primitives;
+  std::vector<TriangleMesh> meshes;
+  // Per primitive and per mesh: 1 when it was written without a `material`, so that an instance's
+  // material replaces it; empty means all 0.
+  std::vector<std::uint8_t> primitiveTakesMaterial;
+  std::vector<std::uint8_t> meshTakesMaterial;
+};
+
+// Of a built group: which primitives and meshes take an instance's material (1) or keep theirs.
+struct GroupMaterialTakers {
+  std::vector<std::uint8_t> primitives;
+  std::vector<std::uint8_t> meshes;
+};
+
 // Everything needed to build a Scene. The scene builder fills this from a scene file; programs may
 // fill it directly. Primitive material indices point into `materials`.
 struct SceneParts {
   std::string name;
   std::vector<Primitive> primitives;
   std::vector<TriangleMesh> meshes;  // mesh material indices point into `materials`
+  std::vector<GroupParts> groups;    // what `instances` place
+  // Instance::group indexes `groups`; Instance::material is a material index or
+  // kNoMaterialOverride.
+  std::vector<Instance> instances;
   Acceleration acceleration = Acceleration::Bvh;
   std::vector<Material> materials{Material{}};     // index 0: the default material
   std::vector<Texture> textures;                   // MaterialTextures' TextureIds index these
@@ -115,15 +137,21 @@ class Scene {
   }
   // The material and the emission of what a ray hit: its primitive's, or its mesh's.
   // (A csg's operands may each have their own: Primitive::materialIndexAt(hit.part).)
-  const Material& materialOf(const Hit& hit) const {
-    return materials_[hit.mesh == kNoMesh
-                          ? aggregate_.primitives()[hit.primitive].materialIndexAt(hit.part)
-                          : aggregate_.meshes()[hit.mesh].materialIndex];
+  const Material& materialOf(const Hit& hit) const { return materials_[materialIndexOf(hit)]; }
+  // The index of that material: a primitive's (a csg's operand's, Primitive::materialIndexAt) or
+  // a mesh's; inside an instance, the instance's own for group objects written without one.
+  std::uint32_t materialIndexOf(const Hit& hit) const {
+    if (hit.instance != kNoInstance) return instancedMaterialIndex(hit);
+    return hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].materialIndexAt(hit.part)
+                               : aggregate_.meshes()[hit.mesh].materialIndex;
   }
   const Color& emissionOf(const Hit& hit) const {
-    return hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].emissionAt(hit.part)
-                               : aggregate_.meshes()[hit.mesh].emission;
+    return hit.mesh == kNoMesh ? aggregate_.primitiveOf(hit).emissionAt(hit.part)
+                               : aggregate_.meshOf(hit).emission;
   }
+  // The mesh (hit.mesh != kNoMesh) or primitive a hit is on, inside an instance's group too.
+  const TriangleMesh& meshOf(const Hit& hit) const { return aggregate_.meshOf(hit); }
+  const Primitive& primitiveOf(const Hit& hit) const { return aggregate_.primitiveOf(hit); }
   const std::vector<Texture>& textures() const { return textures_; }
   const std::vector<MaterialTextures>& materialTextures() const { return materialTextures_; }
   // Whether any material or the background has a texture: the renderer then tracks ray
@@ -172,15 +200,13 @@ class Scene {
   // solids that the ray from the camera along its view direction leaves before entering, the one it
   // leaves farthest away outermost.
   const MediumStack& cameraMedia() const { return cameraMedia_; }
-  std::uint32_t materialIndexOf(const Hit& hit) const {
-    return hit.mesh == kNoMesh ? aggregate_.primitives()[hit.primitive].materialIndex()
-                               : aggregate_.meshes()[hit.mesh].materialIndex;
-  }
   // The medium the hit's surface bounds: its material index for a transparent solid, else
   // kNoMedium. These queries follow the nested rule in any scene; the renderer uses them only
   // when nestedMedia().
+  // Objects inside instances are no media: they refract against the medium around them.
   std::uint32_t mediumOf(const Hit& hit) const {
-    return hit.mesh == kNoMesh ? primitiveMedium_[hit.primitive] : kNoMedium;
+    return hit.mesh == kNoMesh && hit.instance == kNoInstance ? primitiveMedium_[hit.primitive]
+                                                              : kNoMedium;
   }
   // The boundary a ray with unit `direction` inside `media` meets at `hit` (crossBoundary).
   Boundary boundaryAt(const Hit& hit, const Vec3& direction, const MediumStack& media,
@@ -203,6 +229,9 @@ class Scene {
 
  private:
   void initialiseMedia();
+  // The material of a hit on an instance: the instance's own for group objects written without
+  // one, else the object's.
+  std::uint32_t instancedMaterialIndex(const Hit& hit) const;
 
   std::string name_;
   std::vector<Material> materials_;
@@ -217,6 +246,9 @@ class Scene {
   Camera camera_;
   ImageSettings image_;
   RenderSettings render_;
+  // Per group the Aggregate of instances() holds (instances.h): which of its primitives and meshes
+  // take an instance's material (GroupParts). Before aggregate_: filled while it is built.
+  std::vector<GroupMaterialTakers> groupTakesMaterial_;
   Aggregate aggregate_;
   std::shared_ptr<const EmitterSampler> emitterSampler_;  // after aggregate_: built from it
   std::vector<LightSurface> lightSurfaces_;

@@ -57,9 +57,11 @@ class Writer {
         y += std::string(key) + ":" + flowOrBlock(*e, e->value, 1) + "\n";
       }
     }
-    // Named textures and materials, those of included files too (the output includes nothing).
+    // Named textures, materials and groups, those of included files too (the output includes
+    // nothing).
     named("textures", EntityKind::TextureEntity);
     named("materials", EntityKind::MaterialEntity);
+    named("groups", EntityKind::GroupEntity);
     list("objects", EntityKind::ObjectEntity);
     list("lights", EntityKind::LightEntity);
   }
