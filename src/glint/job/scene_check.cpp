@@ -97,6 +97,7 @@ SceneFacts sceneFacts(const Scene& scene) {
     facts.unboundedObjects += primitive.isBounded() ? 0 : 1;
   facts.meshes = scene.meshes().size();
   facts.triangles = scene.aggregate().triangleCount();
+  facts.isa = scene.aggregate().isa();
   facts.lights = scene.lights().size();
   for (const Light& light : scene.lights())
     facts.areaLights += std::holds_alternative<AreaLight>(light) ? 1 : 0;

@@ -35,6 +35,7 @@ struct SceneFacts {
   Bounds3 bounds;              // of the bounded objects; empty when there are none
   int maxDepth = 0;            // render.max_depth
   std::uint64_t seed = 0;      // render.seed
+  Isa isa = Isa::Baseline;     // the instruction set the BVH queries run with (core/isa.h)
 };
 
 SceneFacts sceneFacts(const Scene& scene);

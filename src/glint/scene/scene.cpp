@@ -79,8 +79,10 @@ Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materia
   for (std::size_t m = 0; m < parts.meshes.size(); ++m) {
     meshTransmission.push_back(checkMaterial("mesh", m, parts.meshes[m].materialIndex));
   }
-  return Aggregate(std::move(parts.primitives), std::move(transmission), std::move(parts.meshes),
-                   std::move(meshTransmission), parts.acceleration);
+  Aggregate aggregate(std::move(parts.primitives), std::move(transmission), std::move(parts.meshes),
+                      std::move(meshTransmission), parts.acceleration);
+  if (parts.isa) aggregate.setIsa(*parts.isa);
+  return aggregate;
 }
 
 }  // namespace

@@ -84,6 +84,8 @@ struct SceneParts {
   std::vector<Primitive> primitives;
   std::vector<TriangleMesh> meshes;  // mesh material indices point into `materials`
   Acceleration acceleration = Acceleration::Bvh;
+  // The instruction set of the BVH queries (core/isa.h); none: defaultIsa(). Never changes a pixel.
+  std::optional<Isa> isa;
   std::vector<Material> materials{Material{}};     // index 0: the default material
   std::vector<Texture> textures;                   // MaterialTextures' TextureIds index these
   std::vector<MaterialTextures> materialTextures;  // Material::textures index these
