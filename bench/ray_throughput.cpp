@@ -2,7 +2,11 @@
 // (issue 4, bench 1): Mrays/s per scene × ray set × query × thread count, the ratio glint/Embree,
 // the 2-thread speedups, and both BVH build times.
 //
-//   ray_throughput [--runs N] [--quick] [--no-packets] [--embree-isa ISA]
+//   ray_throughput [--runs N] [--quick] [--no-packets] [--embree-isa ISA] [--isas]
+//
+// glint runs its default kernels (GLINT_ISA, else the widest this CPU runs: core/isa.h); with
+// --isas every ISA this CPU runs, one column each, alternating with Embree within every run, and
+// the rows check that all of them gave the same answers bit for bit.
 //
 // Scenes: a 100k- and a 1M-triangle torus over a two-triangle floor, and 1000 spheres (glint:
 // analytic spheres; Embree: RTC_GEOMETRY_TYPE_SPHERE_POINT, a true ray–sphere intersection) over
@@ -21,6 +25,7 @@
 #include "bench_support.h"
 #include "build_measure.h"
 #include "embree_support.h"
+#include "glint/core/isa.h"
 
 namespace glint::bench {
 namespace {
@@ -32,9 +37,12 @@ struct Row {
   Query query;
   int threads;
   std::size_t rayCount;
-  Timing glint, embree1, embree16;
+  std::vector<Timing> glint;  // one per ISA measured (the glint column(s)), in the order of `isas`
+  Timing embree1, embree16;
   double agreement = 0;    // fraction of rays where glint and Embree give the same answer
   double hitFraction = 0;  // of glint's answers: hit / occluded
+  bool isasAgree = true;   // every ISA gave the same answers, bit for bit
+  const Timing& widest() const { return glint.back(); }
 };
 
 double mrays(std::size_t count, const Timing& t) {
@@ -50,9 +58,10 @@ bool sameHit(double tGlint, float tEmbree) {
 }
 
 Row measure(const std::string& sceneName, const RaySet& set, const std::vector<FloatRay>& floatRays,
-            const Aggregate& aggregate, RTCScene embree, Query query, int threads, int runs,
-            bool packets) {
-  Row row{sceneName, set.name, query, threads, set.rays.size(), {}, {}, {}, 0, 0};
+            Aggregate& aggregate, const std::vector<Isa>& isas, RTCScene embree, Query query,
+            int threads, int runs, bool packets) {
+  Row row{sceneName, set.name, query, threads, set.rays.size(), {}, {}, {}, 0, 0, true};
+  row.glint.resize(isas.size());
   const std::size_t n = set.rays.size();
   tbb::task_arena arena(threads);
   std::vector<double> tGlint(n);
@@ -96,12 +105,27 @@ Row measure(const std::string& sceneName, const RaySet& set, const std::vector<F
   };
 
   // One untimed warm-up of each (page faults, caches, TBB workers), then the runs interleaved so
-  // that a change in machine load hits both sides alike.
-  runGlint();
+  // that a change in machine load hits every side alike. Each ISA's first answers are kept to
+  // check that the others give the same bits.
+  std::vector<double> firstT;
+  std::vector<std::uint8_t> firstOcc;
+  for (const Isa isa : isas) {
+    aggregate.setIsa(isa);
+    runGlint();
+    if (isa == isas.front()) {
+      firstT = tGlint;
+      firstOcc = occGlint;
+    } else {
+      row.isasAgree = row.isasAgree && firstT == tGlint && firstOcc == occGlint;
+    }
+  }
   runEmbree(false);
   if (packets) runEmbree(true);
   for (int r = 0; r < runs; ++r) {
-    row.glint.seconds.push_back(runGlint());
+    for (std::size_t k = 0; k < isas.size(); ++k) {
+      aggregate.setIsa(isas[k]);
+      row.glint[k].seconds.push_back(runGlint());
+    }
     row.embree1.seconds.push_back(runEmbree(false));
     if (packets) row.embree16.seconds.push_back(runEmbree(true));
   }
@@ -122,42 +146,66 @@ Row measure(const std::string& sceneName, const RaySet& set, const std::vector<F
   return row;
 }
 
-void printRowHeader(bool packets) {
-  std::printf("%-12s %-7s %-8s %3s | %-18s | %-18s | %12s |%s %6s | %9s\n", "scene", "rays",
-              "query", "thr", "glint Mrays/s", "Embree-1 Mrays/s", "glint/Embree",
-              packets ? " Embree-16 Mrays/s  |" : "", "hits", "agree");
+void printRowHeader(bool packets, const std::vector<Isa>& isas) {
+  std::printf("%-12s %-7s %-8s %3s |", "scene", "rays", "query", "thr");
+  for (const Isa isa : isas) {
+    const std::string title = "glint " + std::string(isaName(isa)) + " Mrays/s";
+    std::printf(" %-18s |", title.c_str());
+  }
+  std::printf(" %-18s |", "Embree-1 Mrays/s");
+  for (const Isa isa : isas) {
+    const std::string title = std::string(isaName(isa)) + "/Embree";
+    std::printf(" %15s |", title.c_str());
+  }
+  std::printf("%s %6s | %9s%s\n", packets ? " Embree-16 Mrays/s  |" : "", "hits", "agree",
+              isas.size() > 1 ? " | ISAs same" : "");
 }
 
 void printRow(const Row& r, bool packets) {
-  char packet[64] = "";
+  std::printf("%-12s %-7s %-8s %3d |", r.scene.c_str(), r.rays.c_str(),
+              r.query == Query::Closest ? "closest" : "shadow", r.threads);
+  for (const Timing& t : r.glint)
+    std::printf(" %8.2f ±%5.1f%%   |", mrays(r.rayCount, t), t.spreadPercent());
+  std::printf(" %8.2f ±%5.1f%%   |", mrays(r.rayCount, r.embree1), r.embree1.spreadPercent());
+  for (const Timing& t : r.glint)
+    std::printf(" %15.2f |", mrays(r.rayCount, t) / mrays(r.rayCount, r.embree1));
   if (packets) {
-    std::snprintf(packet, sizeof packet, " %8.2f ±%5.1f%%   |", mrays(r.rayCount, r.embree16),
-                  r.embree16.spreadPercent());
+    std::printf(" %8.2f ±%5.1f%%   |", mrays(r.rayCount, r.embree16), r.embree16.spreadPercent());
   }
-  std::printf(
-      "%-12s %-7s %-8s %3d | %8.2f ±%5.1f%%   | %8.2f ±%5.1f%%   | %12.2f |%s %5.1f%% | %8.4f%%\n",
-      r.scene.c_str(), r.rays.c_str(), r.query == Query::Closest ? "closest" : "shadow", r.threads,
-      mrays(r.rayCount, r.glint), r.glint.spreadPercent(), mrays(r.rayCount, r.embree1),
-      r.embree1.spreadPercent(), mrays(r.rayCount, r.glint) / mrays(r.rayCount, r.embree1), packet,
-      100 * r.hitFraction, 100 * r.agreement);
+  std::printf(" %5.1f%% | %8.4f%%%s\n", 100 * r.hitFraction, 100 * r.agreement,
+              r.glint.size() > 1 ? (r.isasAgree ? " | yes" : " | NO") : "");
   std::fflush(stdout);
 }
 
 int run(int argc, char** argv) {
   const std::string usage =
-      "usage: ray_throughput [--runs N] [--quick] [--no-packets] [--embree-isa ISA]\n"
+      "usage: ray_throughput [--runs N] [--quick] [--no-packets] [--embree-isa ISA] [--isas]\n"
       "  --runs N      repetitions per figure (median printed; default 5)\n"
       "  --quick       10k-triangle torus instead of 1M, 256x192 rays (smoke test)\n"
       "  --no-packets  skip the informative Embree 16-ray packet column\n"
       "  --embree-isa ISA  run Embree's kernels for ISA (sse2, sse4.2, avx, avx2, avx512) instead\n"
-      "                of the widest this CPU has: glint's own build targets baseline x86-64\n";
-  std::vector<ExtraOption> extra{{"--no-packets", false}, {"--embree-isa", true}};
+      "                of the widest this CPU has\n"
+      "  --isas        every glint ISA this CPU runs (baseline, avx2, avx512) side by side, not\n"
+      "                only the default one (GLINT_ISA, else the widest)\n";
+  std::vector<ExtraOption> extra{
+      {"--no-packets", false}, {"--embree-isa", true}, {"--isas", false}};
   const CommonOptions options = parseCommonOptions(argc, argv, usage, &extra);
   const bool packets = !extra[0].present;
   printHeader("ray throughput: glint vs Embree", options);
 
   EmbreeDevice device(extra[1].present ? "isa=" + extra[1].value : "");
   std::printf("%s; glint double precision, Embree single precision\n", device.describe().c_str());
+  std::vector<Isa> isas{defaultIsa()};
+  if (extra[2].present) {
+    isas.clear();
+    for (const Isa isa : kAllIsas) {
+      if (isaSupportHere().runs(isa)) isas.push_back(isa);
+    }
+  }
+  std::printf("glint kernels:");
+  for (const Isa isa : isas) std::printf(" %s", std::string(isaName(isa)).c_str());
+  std::printf(" (the widest this CPU runs: %s)\n",
+              std::string(isaName(bestIsa(isaSupportHere()))).c_str());
 
   std::vector<BenchScene> scenes;
   scenes.push_back(makeTorusScene(100000));
@@ -181,7 +229,7 @@ int run(int argc, char** argv) {
   std::printf(
       "\n-- ray throughput (Mrays/s, median ± half range; glint/Embree uses Embree-1 = "
       "rtcIntersect1/rtcOccluded1) --\n");
-  printRowHeader(packets);
+  printRowHeader(packets, isas);
   std::vector<Row> rows;
   for (const BenchScene& scene : scenes) {
     std::optional<Aggregate> aggregate;
@@ -199,7 +247,7 @@ int run(int argc, char** argv) {
       const std::vector<FloatRay> floatRays = toFloatRays(set.rays);
       for (Query query : {Query::Closest, Query::Shadow}) {
         for (int threads : threadCounts) {
-          rows.push_back(measure(scene.name, set, floatRays, *aggregate, embree.get(), query,
+          rows.push_back(measure(scene.name, set, floatRays, *aggregate, isas, embree.get(), query,
                                  threads, options.runs, packets));
           printRow(rows.back(), packets);
         }
@@ -208,23 +256,30 @@ int run(int argc, char** argv) {
   }
 
   // 2-thread speedups, and the issue-4 targets over every row.
-  std::printf("\n-- 2-thread speedup (Mrays/s at 2 threads / at 1 thread) --\n");
+  std::printf("\n-- 2-thread speedup (Mrays/s at 2 threads / at 1 thread; glint: %s) --\n",
+              std::string(isaName(isas.back())).c_str());
   std::printf("%-12s %-7s %-8s | %13s | %14s\n", "scene", "rays", "query", "glint speedup",
               "Embree speedup");
   double worstRatio = 1e300, worstSpeedup = 1e300;
   for (std::size_t i = 0; i + 1 < rows.size(); i += 2) {
     const Row& one = rows[i];
     const Row& two = rows[i + 1];
-    const double g = mrays(two.rayCount, two.glint) / mrays(one.rayCount, one.glint);
+    const double g = mrays(two.rayCount, two.widest()) / mrays(one.rayCount, one.widest());
     const double e = mrays(two.rayCount, two.embree1) / mrays(one.rayCount, one.embree1);
     worstSpeedup = std::min(worstSpeedup, g);
     std::printf("%-12s %-7s %-8s | %13.2f | %14.2f\n", one.scene.c_str(), one.rays.c_str(),
                 one.query == Query::Closest ? "closest" : "shadow", g, e);
   }
+  bool isasAgree = true;
   for (const Row& r : rows) {
-    worstRatio = std::min(worstRatio, mrays(r.rayCount, r.glint) / mrays(r.rayCount, r.embree1));
+    worstRatio = std::min(worstRatio, mrays(r.rayCount, r.widest()) / mrays(r.rayCount, r.embree1));
+    isasAgree = isasAgree && r.isasAgree;
   }
-  std::printf("\ntargets: glint/Embree >= 0.80 on every row: worst %.2f -> %s\n", worstRatio,
+  if (isas.size() > 1) {
+    std::printf("\nevery ISA gave the same answers on every row: %s\n", isasAgree ? "yes" : "NO");
+  }
+  std::printf("\ntargets (glint %s): glint/Embree >= 0.80 on every row: worst %.2f -> %s\n",
+              std::string(isaName(isas.back())).c_str(), worstRatio,
               worstRatio >= 0.8 ? "MET" : "NOT MET");
   std::printf("         2-thread speedup >= 1.85 on every row: worst %.2f -> %s\n", worstSpeedup,
               worstSpeedup >= 1.85 ? "MET" : "NOT MET");

@@ -8,7 +8,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -17,6 +19,7 @@
 #include <vector>
 
 #include "cli_harness.h"
+#include "glint/core/isa.h"
 
 namespace glint_cli_test {
 namespace {
@@ -552,6 +555,70 @@ TEST_F(Cli, StatsAddsDetails) {
   for (const char* part :
        {"4 primitives", "4 samples per pixel", "2 threads", "non-finite samples: 0"})
     EXPECT_TRUE(contains(r.err, part)) << part << " missing in:\n" << r.err;
+}
+
+// --isa and GLINT_ISA (core/isa.h): the instruction set of the BVH queries, shown by --stats; a
+// bad name or an ISA this processor lacks exits 2 before anything is written.
+class ScopedEnvironment {
+ public:
+  ScopedEnvironment(const char* name, const char* value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    setenv(name, value, 1);
+  }
+  ScopedEnvironment(const ScopedEnvironment&) = delete;
+  ScopedEnvironment& operator=(const ScopedEnvironment&) = delete;
+  ~ScopedEnvironment() {
+    if (old_) {
+      setenv(name_, old_->c_str(), 1);
+    } else {
+      unsetenv(name_);
+    }
+  }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+TEST_F(Cli, IsaIsChosenByOptionOrEnvironmentAndShownByStats) {
+  const glint::IsaSupport here = glint::isaSupportHere();
+  const std::string best(glint::isaName(glint::bestIsa(here)));
+  RunResult r = run({"render", small(), "-o", "auto.png", "--stats", "--isa", "auto"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "glint: isa: " + best + " ")) << r.err;
+  for (const glint::Isa isa : glint::kAllIsas) {
+    if (!here.runs(isa)) continue;
+    const std::string name(glint::isaName(isa));
+    r = run({"render", small(), "-o", name + ".png", "--stats", "--isa", name});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(contains(r.err, "glint: isa: " + name + " ")) << r.err;
+    EXPECT_EQ(readFile(work_ / (name + ".png")), readFile(work_ / "auto.png")) << name;
+    const ScopedEnvironment forced("GLINT_ISA", name.c_str());
+    r = run({"render", small(), "-o", "env.png", "--stats"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(contains(r.err, "glint: isa: " + name + " ")) << r.err;
+  }
+}
+
+TEST_F(Cli, AnIsaThatCannotRunExitsTwoAndWritesNothing) {
+  RunResult r = run({"render", small(), "-o", "out.png", "--isa", "sse9"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "--isa expects baseline, avx2, avx512 or auto, got 'sse9'")) << r.err;
+  {
+    const ScopedEnvironment forced("GLINT_ISA", "avx1024");
+    r = run({"render", small(), "-o", "out.png"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_TRUE(contains(r.err, "GLINT_ISA expects baseline, avx2, avx512 or auto")) << r.err;
+  }
+  const glint::IsaSupport here = glint::isaSupportHere();
+  for (const glint::Isa isa : glint::kAllIsas) {
+    if (here.runs(isa)) continue;  // on this processor; the refusal itself: core/isa_test.cpp
+    const std::string name(glint::isaName(isa));
+    r = run({"render", small(), "-o", "out.png", "--isa", name});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_TRUE(contains(r.err, "--isa " + name + ": this")) << r.err;
+  }
+  EXPECT_TRUE(filesIn(work_).empty());
 }
 
 TEST_F(Cli, ProgressIsABarRedrawnInPlaceOnATerminal) {

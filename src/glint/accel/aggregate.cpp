@@ -1,6 +1,12 @@
 // The Aggregate: input validation, build references for primitives and mesh triangles, and the two
 // traversals of the 4-wide BVH (closest hit near-child-first, transmittance in any order), plus the
 // brute-force loops they are measured and tested against.
+//
+// Compiled once per instruction set (core/isa.h): as itself for the baseline, and included by
+// aggregate_avx2.cpp and aggregate_avx512.cpp, which define GLINT_ISA_KERNEL (the ISA's suffix of
+// the two queries' names) and GLINT_AGGREGATE_KERNELS_ONLY (everything but the queries left out).
+// The queries are [[gnu::flatten]] so that the inline functions they call are compiled into them
+// for their ISA, never shared with other files (see src/CMakeLists.txt).
 #include "glint/accel/aggregate.h"
 
 #include <emmintrin.h>
@@ -20,6 +26,10 @@
 #include "glint/accel/instances.h"
 #include "glint/accel/slab_test.h"
 #include "glint/core/ulp.h"
+
+#ifndef GLINT_ISA_KERNEL
+#define GLINT_ISA_KERNEL(name) name##Baseline
+#endif
 
 namespace glint {
 
@@ -116,6 +126,7 @@ inline bool crossesTriangle(const WatertightRay& wray, const Vec3& direction,
   return (h.u != 0 && h.v != 0 && h.w != 0) || ownsTouchingHit(wray, v, h);
 }
 
+#ifndef GLINT_AGGREGATE_KERNELS_ONLY
 std::string meshName(std::size_t m) { return "mesh " + std::to_string(m); }
 
 void validateMesh(const TriangleMesh& mesh, std::size_t m) {
@@ -150,8 +161,11 @@ void validateMesh(const TriangleMesh& mesh, std::size_t m) {
                                 " positions");
   }
 }
+#endif  // GLINT_AGGREGATE_KERNELS_ONLY
 
 }  // namespace
+
+#ifndef GLINT_AGGREGATE_KERNELS_ONLY
 
 Aggregate::Aggregate(std::vector<Primitive> primitives, std::vector<Color> primitiveTransmission,
                      std::vector<TriangleMesh> meshes, std::vector<Color> meshTransmission,
@@ -370,7 +384,10 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
   if (len > 0 && std::isfinite(len)) hit.shadingNormal = Normal3(n / len);
 }
 
-bool Aggregate::intersect(const Ray& ray, double tMin, double tMax, Hit& hit) const {
+#endif  // GLINT_AGGREGATE_KERNELS_ONLY
+
+[[gnu::flatten]] bool Aggregate::GLINT_ISA_KERNEL(intersect)(const Ray& ray, double tMin,
+                                                             double tMax, Hit& hit) const {
   if (acceleration_ == Acceleration::BruteForce) return intersectBruteForce(ray, tMin, tMax, hit);
   enum class Found { None, Primitive, Triangle } found = Found::None;
   double closest = tMax;
@@ -513,15 +530,9 @@ bool Aggregate::intersect(const Ray& ray, double tMin, double tMax, Hit& hit) co
   return found != Found::None;
 }
 
-Color Aggregate::transmittance(const Ray& ray, double tMin, double tMax) const {
-  Color result = acceleration_ == Acceleration::BruteForce
-                     ? transmittanceBruteForce(ray, tMin, tMax)
-                     : transmittanceOwn(ray, tMin, tMax);
-  if (instances_ && !isBlack(result)) result *= instances_->transmittance(ray, tMin, tMax);
-  return result;
-}
-
-Color Aggregate::transmittanceOwn(const Ray& ray, double tMin, double tMax) const {
+[[gnu::flatten]] Color Aggregate::GLINT_ISA_KERNEL(transmittance)(const Ray& ray, double tMin,
+                                                                  double tMax) const {
+  if (acceleration_ == Acceleration::BruteForce) return transmittanceBruteForce(ray, tMin, tMax);
   Color result(1);
   // Multiplies in kt once per crossing of primitive `index`; false once the product is black.
   const auto cross = [&](std::uint32_t index) {
@@ -605,6 +616,7 @@ Color Aggregate::transmittanceOwn(const Ray& ray, double tMin, double tMax) cons
   return result;
 }
 
+#ifndef GLINT_AGGREGATE_KERNELS_ONLY
 bool Aggregate::intersectBruteForce(const Ray& ray, double tMin, double tMax, Hit& hit) const {
   bool found = false;
   double closest = tMax;
@@ -687,6 +699,12 @@ Color Aggregate::transmittanceBruteForce(const Ray& ray, double tMin, double tMa
   return result;
 }
 
+Color Aggregate::transmittance(const Ray& ray, double tMin, double tMax) const {
+  Color result = (this->*kernels_->transmittance)(ray, tMin, tMax);
+  if (instances_ && !isBlack(result)) result *= instances_->transmittance(ray, tMin, tMax);
+  return result;
+}
+
 bool Aggregate::intersectInstances(const Ray& ray, double tMin, double tMax, Hit& hit) const {
   return instances_ && instances_->intersect(ray, tMin, tMax, hit);
 }
@@ -717,5 +735,6 @@ Color Aggregate::vertexColor(const Hit& hit) const {
   const double b2 = std::clamp(dot(cross(e1, rel), n) / area, 0.0, 1.0 - b1);
   return m.colors[index[0]] * (1 - b1 - b2) + m.colors[index[1]] * b1 + m.colors[index[2]] * b2;
 }
+#endif  // GLINT_AGGREGATE_KERNELS_ONLY
 
 }  // namespace glint

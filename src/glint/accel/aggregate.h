@@ -10,6 +10,7 @@
 
 #include "glint/accel/bvh4.h"
 #include "glint/core/color.h"
+#include "glint/core/isa.h"
 #include "glint/core/ray.h"
 #include "glint/geometry/shape.h"
 #include "glint/geometry/triangle_mesh.h"
@@ -67,9 +68,18 @@ class Aggregate {
   // Closest hit with tMin < t < tMax. The slab tests run in single precision on boxes rounded
   // outward; rays must have finite origins within ±1e38 and no direction component above 1e30 in
   // magnitude (every ray a scene produces).
-  bool intersect(const Ray& ray, double tMin, double tMax, Hit& hit) const;
-  // Product of kt over every surface crossing in (tMin, tMax); stops early once it is black.
+  bool intersect(const Ray& ray, double tMin, double tMax, Hit& hit) const {
+    return (this->*kernels_->intersect)(ray, tMin, tMax, hit);
+  }
+  // Product of kt over every surface crossing in (tMin, tMax), this aggregate's own (the ISA's
+  // kernel) times its instances'; stops early once it is black.
   Color transmittance(const Ray& ray, double tMin, double tMax) const;
+
+  // The instruction set the two queries run with (core/isa.h); defaultIsa() when built, which
+  // throws IsaError when GLINT_ISA is bad. setIsa throws IsaError when this processor cannot run
+  // `isa`. Every ISA finds the same hits, bit for bit: only the speed differs.
+  void setIsa(Isa isa);
+  Isa isa() const { return kernels_->isa; }
 
   // The instances queried with this aggregate's own primitives and meshes, or null.
   const InstanceSet* instances() const { return instances_.get(); }
@@ -97,9 +107,23 @@ class Aggregate {
   std::size_t memoryBytes() const;
 
  private:
+  // The two queries, compiled once per ISA: aggregate.cpp as itself (Baseline), and again inside
+  // aggregate_avx2.cpp and aggregate_avx512.cpp with that ISA's flags (src/CMakeLists.txt).
+  bool intersectBaseline(const Ray& ray, double tMin, double tMax, Hit& hit) const;
+  bool intersectAvx2(const Ray& ray, double tMin, double tMax, Hit& hit) const;
+  bool intersectAvx512(const Ray& ray, double tMin, double tMax, Hit& hit) const;
+  Color transmittanceBaseline(const Ray& ray, double tMin, double tMax) const;
+  Color transmittanceAvx2(const Ray& ray, double tMin, double tMax) const;
+  Color transmittanceAvx512(const Ray& ray, double tMin, double tMax) const;
+  struct Kernels {
+    bool (Aggregate::*intersect)(const Ray&, double, double, Hit&) const;
+    Color (Aggregate::*transmittance)(const Ray&, double, double) const;
+    Isa isa;
+  };
+  static const Kernels& kernelsFor(Isa isa);  // aggregate_isa.cpp
+
   bool intersectBruteForce(const Ray& ray, double tMin, double tMax, Hit& hit) const;
   Color transmittanceBruteForce(const Ray& ray, double tMin, double tMax) const;
-  Color transmittanceOwn(const Ray& ray, double tMin, double tMax) const;  // without instances
   bool intersectInstances(const Ray& ray, double tMin, double tMax, Hit& hit) const;
   // normal: the triangle's unnormalised geometric normal (p1 − p0) × (p2 − p0).
   void finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle, const WatertightHit& candidate,
@@ -126,6 +150,7 @@ class Aggregate {
   Bounds3 bounds_;
   Acceleration acceleration_ = Acceleration::Bvh;
   std::shared_ptr<const InstanceSet> instances_;
+  const Kernels* kernels_ = &kernelsFor(defaultIsa());
 };
 
 }  // namespace glint

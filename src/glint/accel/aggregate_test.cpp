@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -1190,6 +1191,65 @@ TEST(AggregateMeshTest, ParallelBuildIsIndependentOfTheThreadCount) {
       static_cast<double>(one.memoryBytes()) / static_cast<double>(one.triangleCount());
   EXPECT_LE(bytesPerTriangle, 64);
   EXPECT_GT(bytesPerTriangle, 36);  // the mesh alone takes 36
+}
+
+// Instruction sets (core/isa.h). ctest also runs every test of this file under GLINT_ISA=avx2 and
+// GLINT_ISA=avx512 (tests/CMakeLists.txt: aggregate_properties_*), where each Aggregate above
+// starts with that ISA's kernels; here one tree is queried with every ISA this processor runs.
+bool identicalHit(const Hit& a, const Hit& b) {
+  return a.t == b.t && a.normal == b.normal && a.shadingNormal == b.shadingNormal &&
+         a.point == b.point && a.pointError == b.pointError && a.primitive == b.primitive &&
+         a.mesh == b.mesh && a.triangle == b.triangle;
+}
+
+TEST(AggregateIsaTest, EveryIsaFindsTheBaselineHitsBitForBit) {
+  const IsaSupport here = isaSupportHere();
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    SCOPED_TRACE("scene seed " + std::to_string(seed));
+    const MeshScene s = randomMeshScene(seed);
+    Aggregate bvh = s.make(Acceleration::Bvh);
+    EXPECT_EQ(bvh.isa(), defaultIsa());
+    const std::vector<Query> queries = meshQueries(s, 700 + seed, 1000);
+    bvh.setIsa(Isa::Baseline);
+    std::vector<std::optional<Hit>> hits;
+    std::vector<Color> transmittances;
+    for (const Query& q : queries) {
+      Hit hit;
+      hits.push_back(bvh.intersect(q.ray, q.tMin, q.tMax, hit) ? std::optional(hit) : std::nullopt);
+      transmittances.push_back(bvh.transmittance(q.ray, q.tMin, q.tMax));
+    }
+    for (const Isa isa : kAllIsas) {
+      SCOPED_TRACE(std::string(isaName(isa)));
+      if (!here.runs(isa)) {
+        EXPECT_THROW(bvh.setIsa(isa), IsaError);
+        continue;
+      }
+      bvh.setIsa(isa);
+      EXPECT_EQ(bvh.isa(), isa);
+      int mismatches = 0;
+      for (std::size_t i = 0; i < queries.size(); ++i) {
+        const Query& q = queries[i];
+        Hit hit;
+        const bool found = bvh.intersect(q.ray, q.tMin, q.tMax, hit);
+        const bool same = found == hits[i].has_value() && (!found || identicalHit(hit, *hits[i])) &&
+                          bvh.transmittance(q.ray, q.tMin, q.tMax) == transmittances[i];
+        mismatches += same ? 0 : 1;
+      }
+      EXPECT_EQ(mismatches, 0) << "of " << queries.size() << " queries";
+    }
+  }
+}
+
+TEST(AggregateIsaTest, AggregatesStartWithTheProcessDefault) {
+  const TestScene s = randomScene(2, 20);
+  const Aggregate aggregate(s.prims, s.kt);
+  EXPECT_EQ(aggregate.isa(), defaultIsa());
+  const char* forced = std::getenv("GLINT_ISA");
+  if (forced != nullptr && *forced != '\0' && std::string(forced) != "auto") {
+    EXPECT_EQ(isaName(aggregate.isa()), forced);
+  } else {
+    EXPECT_EQ(aggregate.isa(), bestIsa(isaSupportHere()));
+  }
 }
 
 }  // namespace

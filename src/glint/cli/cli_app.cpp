@@ -28,6 +28,7 @@
 #include "glint/cli/preview_session.h"
 #include "glint/cli/progress_reporter.h"
 #include "glint/cli/signal_guard.h"
+#include "glint/core/isa.h"
 #include "glint/job/job_error.h"
 #include "glint/job/render_job.h"
 #include "glint/job/scene_check.h"
@@ -77,6 +78,7 @@ struct RenderArgs {
   std::string output;
   std::optional<std::string> width, height, samples, threads, seed, crop, maxMemory, integrator;
   std::optional<std::string> checkpoint, resume;  // checkpoint files
+  std::optional<std::string> isa;                 // --isa: baseline, avx2, avx512 or auto
   bool quiet = false;
   bool stats = false;
   std::optional<PreviewRequest> preview;  // --preview and its options
@@ -292,6 +294,8 @@ void printStats(const RenderJobResult& result, int threads) {
                       formatDuration(timings.load), formatDuration(timings.build),
                       formatDuration(timings.render), formatDuration(timings.write));
   text += fmt::format("glint: non-finite samples: {}\n", stats.nonFinite);
+  text += fmt::format("glint: isa: {} (BVH queries; this processor runs up to {})\n",
+                      isaName(scene.isa), isaName(bestIsa(isaSupportHere())));
   emit(stderr, text);
 }
 
@@ -402,6 +406,13 @@ RenderJobSpec parseRequest(const RenderArgs& args) {
   spec.requestText = fmt::format("{}", fmt::join(named, " "));
   if (args.checkpoint) spec.checkpoint = std::filesystem::path(*args.checkpoint);
   if (args.resume) spec.resume = std::filesystem::path(*args.resume);
+  if (args.isa) {
+    try {
+      spec.isa = resolveIsa(*args.isa, "--isa", isaSupportHere());
+    } catch (const IsaError& error) {
+      throw CliError(kExitBadInput, error.what());
+    }
+  }
   return spec;
 }
 
@@ -579,6 +590,13 @@ int runCommandLine(int argc, char** argv) {
                        "Continue the render saved in FILE (same scene and options), and keep "
                        "checkpointing into it unless --checkpoint names another file")
           ->type_name("FILE");
+  std::string isa;
+  CLI::Option* isaOption =
+      render
+          ->add_option("--isa", isa,
+                       "Instruction set of the BVH queries: baseline, avx2, avx512 or auto (the "
+                       "widest this processor runs; default, or GLINT_ISA); never changes a pixel")
+          ->type_name("ISA");
   render->add_flag("--quiet", args.quiet, "No progress and no summary; errors only");
   render->add_flag("--stats", args.stats, "More statistics at the end");
   const PreviewOptions previewOptions(*render);
@@ -647,6 +665,7 @@ int runCommandLine(int argc, char** argv) {
   args.maxMemory = given(maxMemoryOption, maxMemory);
   args.checkpoint = given(checkpointOption, checkpoint);
   args.resume = given(resumeOption, resume);
+  args.isa = given(isaOption, isa);
   try {
     args.preview = previewOptions.request();
   } catch (const PreviewError& error) {

@@ -44,6 +44,7 @@ void loadRender(const RenderJobSpec& spec, int threads, const std::string& host,
     allocated.width = loaded.region.width();
     allocated.height = loaded.region.height();
     enforceImageLimits(allocated, spec.requestText, spec.memoryBudget);
+    scene.parts.isa = spec.isa;  // --isa on every rank (a rank whose CPU lacks it reports so)
     loaded.scene.emplace(freezeScene(std::move(scene.parts), spec.scene.string()));
     const std::string bytes = readSceneFileAgain(spec.scene);
     loaded.identity = identityOf(spec.scene, bytes, *loaded.scene,

@@ -46,20 +46,10 @@ inline bool isDegenerateTriangle(const Point3& p0, const Point3& p1, const Point
 namespace watertight_detail {
 
 // The 2D edge function a·b − c·d. Watertightness needs edge(p, q) = −edge(q, p) in sign, exactly.
-// Plain double arithmetic gives that (rounding is symmetric), but when the target has FMA the
-// compiler may fuse one of the two products (GCC contracts by default in C++), breaking the
-// symmetry. There Kahan's difference of products (relative error ≤ 2u, Jeannerod, Louvet and
-// Muller 2013) is used instead: it returns the sign of the exact value, which is antisymmetric, and
-// exactly 0 only when the exact value is 0.
-inline double edgeFunction(double a, double b, double c, double d) {
-#ifdef __FMA__
-  const double cd = c * d;
-  const double roundingOfCd = std::fma(-c, d, cd);
-  return std::fma(a, b, -cd) + roundingOfCd;
-#else
-  return a * b - c * d;
-#endif
-}
+// Plain double arithmetic gives that: rounding is symmetric, and glint is compiled with
+// -ffp-contract=off (src/CMakeLists.txt), so neither product is fused into an FMA on a target that
+// has one — which would break the symmetry and make the result depend on the ISA.
+inline double edgeFunction(double a, double b, double c, double d) { return a * b - c * d; }
 
 // Coordinate `axis` (0 = x, 1 = y, 2 = z) of a Point3 or Vec3 read from its object representation:
 // one load with a computed offset, where operator[] would branch.

@@ -13,6 +13,7 @@
 #include "glint/core/atomic_file.h"
 #include "glint/core/cancel.h"
 #include "glint/core/file_access.h"
+#include "glint/core/isa.h"
 #include "glint/image/image_writer.h"
 #include "glint/job/checkpoint.h"
 #include "glint/job/job_steps.h"
@@ -65,6 +66,18 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
                    "a scene built in code cannot be checkpointed: it has no file to fingerprint");
   if (!fromFile && spec.output.empty())
     throw JobError(JobFailure::BadInput, "a scene built in code needs an output path");
+  // The kernels' ISA: a bad GLINT_ISA is refused even when spec.isa overrides it, since every
+  // Aggregate starts from defaultIsa().
+  Isa isa = Isa::Baseline;
+  try {
+    isa = defaultIsa();
+    if (spec.isa) {
+      requireIsa(*spec.isa);
+      isa = *spec.isa;
+    }
+  } catch (const IsaError& error) {
+    throw JobError(JobFailure::BadInput, error.what());
+  }
   const fs::path out = spec.output.empty() ? defaultOutputPath(spec.scene) : spec.output;
   checkOutputPath(out, fromFile ? spec.scene : fs::path(), spec.resume);
   const std::optional<fs::path> checkpointPath =
@@ -125,6 +138,7 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
   if (isCancelled(spec.cancel)) return interrupted();
 
   phase = Clock::now();
+  parts.isa = isa;
   const Scene scene = freezeScene(std::move(parts), sceneName);
   result.timings.build = secondsSince(phase);
   result.scene = sceneFacts(scene);

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "glint/core/isa.h"
 #include "glint/job/job_error.h"
 #include "glint/job/scene_check.h"
 #include "glint/readers/diagnostics.h"
@@ -44,6 +45,10 @@ struct RenderJobSpec {
   std::optional<std::filesystem::path> checkpoint;
   std::optional<std::filesystem::path> resume;  // continue the render saved in this checkpoint
   int tileSize = 16;                            // pixels per tile side; part of the fingerprint
+  // The instruction set of the BVH queries (core/isa.h); none: defaultIsa() (GLINT_ISA, else the
+  // widest this processor runs). Never changes a pixel. One this processor lacks, or a bad
+  // GLINT_ISA, is bad input (exit status 2) before any work.
+  std::optional<Isa> isa;
   // Least time between periodic checkpoint saves (longer when a save is slow: at most ~5% of the
   // render goes to saving).
   std::chrono::duration<double> checkpointInterval = std::chrono::seconds(5);

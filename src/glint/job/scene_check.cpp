@@ -103,6 +103,7 @@ SceneFacts sceneFacts(const Scene& scene) {
     for (std::uint32_t g = 0; g < instances->groupCount(); ++g)
       facts.groupTriangles += instances->group(g).triangleCount();
   }
+  facts.isa = scene.aggregate().isa();
   facts.lights = scene.lights().size();
   for (const Light& light : scene.lights())
     facts.areaLights += std::holds_alternative<AreaLight>(light) ? 1 : 0;

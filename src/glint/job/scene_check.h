@@ -39,6 +39,7 @@ struct SceneFacts {
   int maxDepth = 0;                  // render.max_depth
   std::uint64_t seed = 0;            // render.seed
   Integrator integrator = Integrator::Whitted;  // render.integrator, after --integrator
+  Isa isa = Isa::Baseline;  // the instruction set the BVH queries run with (core/isa.h)
 };
 
 SceneFacts sceneFacts(const Scene& scene);

@@ -105,8 +105,10 @@ Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materia
   for (std::size_t m = 0; m < parts.meshes.size(); ++m) {
     meshTransmission.push_back(checkMaterial("mesh", m, parts.meshes[m].materialIndex));
   }
-  return Aggregate(std::move(parts.primitives), std::move(transmission), std::move(parts.meshes),
-                   std::move(meshTransmission), parts.acceleration, std::move(instances));
+  Aggregate aggregate(std::move(parts.primitives), std::move(transmission), std::move(parts.meshes),
+                      std::move(meshTransmission), parts.acceleration, std::move(instances));
+  if (parts.isa) aggregate.setIsa(*parts.isa);
+  return aggregate;
 }
 
 // Whether a shape bounds a volume with outward normals, so that a ray crossing it enters or leaves

@@ -107,6 +107,8 @@ struct SceneParts {
   // kNoMaterialOverride.
   std::vector<Instance> instances;
   Acceleration acceleration = Acceleration::Bvh;
+  // The instruction set of the BVH queries (core/isa.h); none: defaultIsa(). Never changes a pixel.
+  std::optional<Isa> isa;
   std::vector<Material> materials{Material{}};     // index 0: the default material
   std::vector<Texture> textures;                   // MaterialTextures' TextureIds index these
   std::vector<MaterialTextures> materialTextures;  // Material::textures index these

@@ -110,14 +110,15 @@ std::shared_ptr<const InstanceSet> buildInstanceSet(SceneParts& parts,
     t.primitives.resize(group.primitives.size(), 0);
     t.meshes.resize(group.meshes.size(), 0);
     takers.push_back(std::move(t));
-    if (lastUse[g] == r) {
-      aggregates.push_back(std::make_shared<const Aggregate>(
-          std::move(group.primitives), std::move(pKt), std::move(group.meshes), std::move(mKt),
-          parts.acceleration));
-    } else {
-      aggregates.push_back(std::make_shared<const Aggregate>(
-          group.primitives, std::move(pKt), group.meshes, std::move(mKt), parts.acceleration));
-    }
+    std::shared_ptr<Aggregate> aggregate =
+        lastUse[g] == r
+            ? std::make_shared<Aggregate>(std::move(group.primitives), std::move(pKt),
+                                          std::move(group.meshes), std::move(mKt),
+                                          parts.acceleration)
+            : std::make_shared<Aggregate>(group.primitives, std::move(pKt), group.meshes,
+                                          std::move(mKt), parts.acceleration);
+    if (parts.isa) aggregate->setIsa(*parts.isa);  // the groups' queries run as the scene's
+    aggregates.push_back(std::move(aggregate));
   }
   parts.groups.clear();
   return std::make_shared<const InstanceSet>(std::move(aggregates), std::move(parts.instances));

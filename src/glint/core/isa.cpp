@@ -1,0 +1,103 @@
+#include "glint/core/isa.h"
+
+#include <cstdlib>
+#include <string>
+#include <variant>
+
+namespace glint {
+
+std::string_view isaName(Isa isa) {
+  switch (isa) {
+    case Isa::Avx2:
+      return "avx2";
+    case Isa::Avx512:
+      return "avx512";
+    case Isa::Baseline:
+      break;
+  }
+  return "baseline";
+}
+
+std::optional<Isa> parseIsa(std::string_view name) {
+  for (const Isa isa : kAllIsas) {
+    if (name == isaName(isa)) return isa;
+  }
+  return std::nullopt;
+}
+
+IsaSupport isaSupportHere() {
+  IsaSupport support;
+  // GLINT_ISA_KERNELS: CMake compiled aggregate_avx2.cpp and aggregate_avx512.cpp with their ISA's
+  // flags (x86-64 and g++; elsewhere they are baseline copies that are never chosen).
+#if GLINT_ISA_KERNELS
+  support.compiled[static_cast<int>(Isa::Avx2)] = true;
+  support.compiled[static_cast<int>(Isa::Avx512)] = true;
+  // GCC's CPU model checks CPUID and that the OS saves the AVX and AVX-512 registers (XGETBV).
+  __builtin_cpu_init();
+  support.cpu[static_cast<int>(Isa::Avx2)] = __builtin_cpu_supports("x86-64-v3") != 0;
+  support.cpu[static_cast<int>(Isa::Avx512)] = __builtin_cpu_supports("x86-64-v4") != 0;
+#endif
+  return support;
+}
+
+Isa bestIsa(const IsaSupport& support) {
+  Isa best = Isa::Baseline;
+  for (const Isa isa : kAllIsas) {
+    if (support.runs(isa)) best = isa;
+  }
+  return best;
+}
+
+namespace {
+
+std::string describe(Isa isa) {
+  switch (isa) {
+    case Isa::Avx2:
+      return "AVX2 (x86-64-v3)";
+    case Isa::Avx512:
+      return "AVX-512 (x86-64-v4)";
+    case Isa::Baseline:
+      break;
+  }
+  return "the baseline";
+}
+
+}  // namespace
+
+Isa resolveIsa(std::string_view request, std::string_view where, const IsaSupport& support) {
+  if (request == "auto") return bestIsa(support);
+  const std::optional<Isa> isa = parseIsa(request);
+  if (!isa) {
+    throw IsaError(std::string(where) + " expects baseline, avx2, avx512 or auto, got '" +
+                   std::string(request) + "'");
+  }
+  if (!support.compiled[static_cast<int>(*isa)]) {
+    throw IsaError(std::string(where) + " " + std::string(request) + ": this glint was built " +
+                   "without " + describe(*isa) + " kernels (baseline only)");
+  }
+  if (!support.cpu[static_cast<int>(*isa)]) {
+    throw IsaError(std::string(where) + " " + std::string(request) + ": this processor lacks " +
+                   describe(*isa) + "; it runs " + std::string(isaName(bestIsa(support))));
+  }
+  return *isa;
+}
+
+void requireIsa(Isa isa) { resolveIsa(isaName(isa), "ISA", isaSupportHere()); }
+
+Isa defaultIsa() {
+  // Resolved once: a kernel choice per Aggregate must not cost a getenv and CPUID.
+  static const std::variant<Isa, IsaError> chosen = []() -> std::variant<Isa, IsaError> {
+    const IsaSupport support = isaSupportHere();
+    const char* request = std::getenv("GLINT_ISA");
+    if (request == nullptr || *request == '\0') return bestIsa(support);
+    try {
+      return resolveIsa(request, "GLINT_ISA", support);
+    } catch (const IsaError& error) {
+      return error;
+    }
+  }();
+  if (const auto* error = std::get_if<IsaError>(&chosen)) throw *error;
+  return std::get<Isa>(chosen);
+}
+
+}  // namespace glint
