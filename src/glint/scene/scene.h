@@ -160,11 +160,12 @@ class Scene {
   }
 
   // ---- Nested dielectrics (DESIGN.md §11, scene/media.h) ----
-  // A transparent solid is a sphere, box, cylinder or tube whose material has kt > 0; its medium
-  // is its material. Rays track the media they are inside only when some transparent solid's
-  // bounds overlap another transparent object's: otherwise no ray can be inside two media at once
-  // or meet a boundary that is no surface, every surface refracts against air exactly as the
-  // queries above assume, and the renderer uses them unchanged.
+  // A transparent solid is a sphere, box, cylinder, tube or closed mesh (closed and consistently
+  // oriented, outward) whose material has kt > 0; its medium is its material. Rays track the media
+  // they are inside only when some transparent solid's bounds overlap another transparent object's:
+  // otherwise no ray can be inside two media at once or meet a boundary that is no surface, every
+  // surface refracts against air exactly as the queries above assume, and the renderer uses them
+  // unchanged.
   bool nestedMedia() const { return nestedMedia_; }
   // The media the camera's position is inside (nestedMedia only, else empty): the transparent
   // solids that the ray from the camera along its view direction leaves before entering, the one it
@@ -178,7 +179,7 @@ class Scene {
   // kNoMedium. These queries follow the nested rule in any scene; the renderer uses them only
   // when nestedMedia().
   std::uint32_t mediumOf(const Hit& hit) const {
-    return hit.mesh == kNoMesh ? primitiveMedium_[hit.primitive] : kNoMedium;
+    return hit.mesh == kNoMesh ? primitiveMedium_[hit.primitive] : meshMedium_[hit.mesh];
   }
   // The boundary a ray with unit `direction` inside `media` meets at `hit` (crossBoundary).
   Boundary boundaryAt(const Hit& hit, const Vec3& direction, const MediumStack& media,
@@ -220,6 +221,7 @@ class Scene {
   std::vector<LightSurface> lightSurfaces_;
   bool nestedMedia_ = false;
   std::vector<std::uint32_t> primitiveMedium_;  // per primitive: mediumOf
+  std::vector<std::uint32_t> meshMedium_;       // per mesh: mediumOf
   std::vector<Color> materialTransmission_;     // per material: the kt a shadow ray keeps
   MediumStack cameraMedia_;
 };
