@@ -220,6 +220,14 @@ bool Scene::intersect(const Ray& ray, double tMax, Hit& hit, MediumStack& media)
 }
 
 Color Scene::transmittance(const Ray& ray, double tMax, const MediumStack& start) const {
+  if (mediaKtInUnitInterval_) {
+    // Every crossing keeps at most 1 of each channel and a medium's more than 0, so a product over
+    // all crossings of exactly 1 (nothing that dims in the way) or 0 (something that is not a
+    // medium, hence always a surface, blocks; barring underflow) is also the product over the
+    // crossings that are surfaces. Only the rays in between need the ordered walk.
+    const Color all = aggregate_.transmittance(ray, 0, tMax);
+    if (all == Color(1) || isBlack(all)) return all;
+  }
   MediumStack media = start;
   Color result(1);
   Ray segment = ray;
@@ -305,6 +313,18 @@ void Scene::initialiseMedia() {
   }
   nestedMedia_ =
       transparentSolidsOverlap(primitives, primitiveMedium_, meshes, meshMedium_, materials_);
+  // The shortcut of transmittance(ray, tMax, media): no material's shadow kt exceeds 1 in any
+  // channel, and no medium's is 0 in any.
+  const auto atMostOne = [](const Color& kt) { return kt.r <= 1 && kt.g <= 1 && kt.b <= 1; };
+  const auto positiveMedium = [&](std::uint32_t medium) {
+    if (medium == kNoMedium) return true;
+    const Color& kt = materialTransmission_[medium];
+    return kt.r > 0 && kt.g > 0 && kt.b > 0;
+  };
+  mediaKtInUnitInterval_ =
+      std::all_of(materialTransmission_.begin(), materialTransmission_.end(), atMostOne) &&
+      std::all_of(primitiveMedium_.begin(), primitiveMedium_.end(), positiveMedium) &&
+      std::all_of(meshMedium_.begin(), meshMedium_.end(), positiveMedium);
   if (!nestedMedia_) return;
 
   // The camera's media: march along its view direction through every surface; a solid whose first

@@ -224,6 +224,9 @@ class Scene {
   std::vector<std::uint32_t> meshMedium_;       // per mesh: mediumOf
   std::vector<Color> materialTransmission_;     // per material: the kt a shadow ray keeps
   MediumStack cameraMedia_;
+  // Every material's shadow kt is at most 1 and every medium's above 0 in each channel:
+  // transmittance(ray, tMax, media) may answer from the order-free query when it gives 1 or 0.
+  bool mediaKtInUnitInterval_ = false;
 };
 
 }  // namespace glint
