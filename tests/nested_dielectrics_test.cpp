@@ -273,6 +273,72 @@ objects:
   EXPECT_EQ(scene.cameraMedia()[1], 1u);  // glass, innermost
 }
 
+// A glass sphere of radius 1 at the origin with a cube mesh of half-size 0.5 inside it, both of one
+// glass material; `faces` picks the cube's triangles (12: closed), `inward` flips their winding.
+Scene sphereWithCubeMesh(int faces, bool inward) {
+  SceneParts parts;
+  parts.camera.position = {0, 0, 5};
+  parts.camera.direction = {0, 0, -1};
+  parts.camera.up = {0, 1, 0};
+  parts.camera.viewPlaneWidth = 1;
+  parts.camera.viewPlaneHeight = 1;
+  parts.camera.viewPlaneDistance = 1;
+  parts.image.width = 4;
+  parts.image.height = 4;
+  Material glass;
+  glass.kt = Color(0.8);
+  glass.ior = 1.5;
+  parts.materials.push_back(glass);
+  parts.primitives.emplace_back(Sphere::make({0, 0, 0}, 1), 1u, Color{});
+  TriangleMesh cube;
+  const double h = 0.5;
+  cube.positions = {{-h, -h, -h}, {h, -h, -h}, {h, h, -h}, {-h, h, -h},
+                    {-h, -h, h},  {h, -h, h},  {h, h, h},  {-h, h, h}};
+  const std::vector<std::uint32_t> outward = {0, 3, 2, 0, 2, 1, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                                              3, 7, 6, 3, 6, 2, 0, 4, 7, 0, 7, 3, 1, 2, 6, 1, 6, 5};
+  for (int t = 0; t < faces; ++t) {
+    const std::size_t i = 3 * static_cast<std::size_t>(t);
+    if (inward) {
+      cube.indices.insert(cube.indices.end(), {outward[i], outward[i + 2], outward[i + 1]});
+    } else {
+      cube.indices.insert(cube.indices.end(), {outward[i], outward[i + 1], outward[i + 2]});
+    }
+  }
+  cube.materialIndex = 1;
+  parts.meshes.push_back(std::move(cube));
+  return Scene(std::move(parts));
+}
+
+TEST(NestedDielectrics, AClosedOutwardMeshIsASolid) {
+  // Along the x axis: the sphere at ±1, the cube's faces at ±0.5 (crossed through face centres).
+  const Ray through{{-3, 0.1, 0.2}, {1, 0, 0}};
+  const Scene closed = sphereWithCubeMesh(12, false);
+  ASSERT_TRUE(closed.nestedMedia());
+  // The cube is of the sphere's glass: its faces are no surface, for shadow rays and for rays.
+  EXPECT_EQ(closed.transmittance(through, kInfinity, MediumStack{}), Color(0.8 * 0.8));
+  MediumStack media;
+  Hit hit;
+  ASSERT_TRUE(closed.intersect(through, kInfinity, hit, media));
+  EXPECT_NEAR(hit.point.x, -std::sqrt(1 - 0.05), 1e-12);  // the sphere
+  Ray inside = spawnRay(hit.point, hit.pointError, hit.normal, through.direction);
+  MediumStack beyond;
+  closed.boundaryAt(hit, through.direction, media, beyond);
+  ASSERT_TRUE(closed.intersect(inside, kInfinity, hit, beyond));
+  EXPECT_NEAR(hit.point.x, std::sqrt(1 - 0.05), 1e-12);  // the sphere's far side: the cube passed
+  // An open cube (two triangles missing) or one facing inward bounds nothing: a surface each time.
+  for (const auto& [faces, inward] : {std::pair{10, false}, std::pair{12, true}}) {
+    const Scene sheets = sphereWithCubeMesh(faces, inward);
+    Hit first;
+    MediumStack none;
+    ASSERT_TRUE(sheets.intersect(through, kInfinity, first, none));
+    EXPECT_EQ(sheets.mediumOf(first), 1u);  // the sphere
+    const Ray on = spawnRay(first.point, first.pointError, first.normal, through.direction);
+    ASSERT_TRUE(sheets.intersect(on, kInfinity, first, none));
+    EXPECT_EQ(first.mesh, 0u);
+    EXPECT_EQ(sheets.mediumOf(first), kNoMedium);
+  }
+}
+
 TEST(NestedDielectrics, PriorityIsAWholeNumberAtLeastZero) {
   const std::string scene = std::string(testing::kMinimal) + "materials:\n";
   testing::expectOneError(scene + "  water: {kt: 0.9, priority: 1.5}\n", 4, 30,

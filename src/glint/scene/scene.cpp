@@ -2,8 +2,10 @@
 #include "glint/scene/scene.h"
 
 #include <algorithm>
+#include <bit>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 #include <utility>
 #include <variant>
@@ -131,11 +133,58 @@ struct BoundsVolume {
   bool operator()(const Csg&) const { return false; }
 };
 
+// Whether a mesh is the boundary of a volume with outward normals, so that it can be a medium:
+// closed and consistently oriented — with vertices of equal position taken as one, every edge is
+// used by exactly two triangles, once in each direction — and of positive signed volume
+// (Σ p0·(p1 × p2) / 6 over its triangles, the divergence theorem). Degenerate triangles are
+// already gone (Aggregate).
+bool meshBoundsVolume(const TriangleMesh& mesh) {
+  const std::size_t triangles = mesh.triangleCount();
+  if (triangles < 4) return false;
+  struct PositionHash {
+    std::size_t operator()(const Point3& p) const {
+      std::uint64_t h = 0xcbf29ce484222325u;
+      for (const double c : {p.x + 0.0, p.y + 0.0, p.z + 0.0}) {  // + 0.0: −0 and 0 alike
+        h = (h ^ std::bit_cast<std::uint64_t>(c)) * 0x100000001b3u;
+      }
+      return static_cast<std::size_t>(h ^ (h >> 29));
+    }
+  };
+  std::unordered_map<Point3, std::uint32_t, PositionHash> welded;
+  std::vector<std::uint32_t> weldedId(mesh.positions.size());
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    weldedId[i] =
+        welded.emplace(mesh.positions[i], static_cast<std::uint32_t>(welded.size())).first->second;
+  }
+  std::unordered_map<std::uint64_t, int> directedEdges;  // (from << 32 | to) → uses
+  double volume6 = 0;
+  for (std::size_t t = 0; t < triangles; ++t) {
+    const std::uint32_t* index = mesh.indices.data() + 3 * t;
+    for (int k = 0; k < 3; ++k) {
+      const std::uint64_t from = weldedId[index[k]];
+      const std::uint64_t to = weldedId[index[(k + 1) % 3]];
+      if (from == to || ++directedEdges[from << 32 | to] > 1) return false;
+    }
+    volume6 += dot(toVec(mesh.positions[index[0]]),
+                   cross(mesh.positions[index[1]] - mesh.positions[index[0]],
+                         mesh.positions[index[2]] - mesh.positions[index[0]]));
+  }
+  for (const auto& [edge, uses] : directedEdges) {
+    if (directedEdges.find(edge >> 32 | (edge & 0xffffffffu) << 32) == directedEdges.end()) {
+      return false;
+    }
+  }
+  return volume6 > 0;
+}
+
 // Whether some transparent solid's bounds overlap another transparent object's (solid or flat):
 // the only way a ray can be inside two media at once, or meet a flat transparent surface inside a
-// medium. Sweep and prune along x; past a budget of box tests the answer is a conservative yes.
+// medium. `primitiveMedium` / `meshMedium`: each object's medium (kNoMedium: not a solid). Sweep
+// and prune along x; past a budget of box tests the answer is a conservative yes.
 bool transparentSolidsOverlap(const std::vector<Primitive>& primitives,
+                              const std::vector<std::uint32_t>& primitiveMedium,
                               const std::vector<TriangleMesh>& meshes,
+                              const std::vector<std::uint32_t>& meshMedium,
                               const std::vector<Material>& materials) {
   struct Candidate {
     Bounds3 bounds;
@@ -143,19 +192,22 @@ bool transparentSolidsOverlap(const std::vector<Primitive>& primitives,
   };
   std::vector<Candidate> candidates;
   bool anySolid = false;
-  for (const Primitive& primitive : primitives) {
-    if (isBlack(materials[primitive.materialIndex()].kt)) continue;
-    const bool solid = std::visit(BoundsVolume{}, primitive.shape());
+  for (std::size_t i = 0; i < primitives.size(); ++i) {
+    if (isBlack(materials[primitives[i].materialIndex()].kt)) continue;
+    const bool solid = primitiveMedium[i] != kNoMedium;
     anySolid = anySolid || solid;
-    candidates.push_back({primitive.bounds(), solid});
+    candidates.push_back({primitives[i].bounds(), solid});
   }
-  if (!anySolid) return false;
-  for (const TriangleMesh& mesh : meshes) {
+  for (std::size_t m = 0; m < meshes.size(); ++m) {
+    const TriangleMesh& mesh = meshes[m];
     if (isBlack(materials[mesh.materialIndex].kt) || mesh.positions.empty()) continue;
     Bounds3 bounds;
     for (const Point3& p : mesh.positions) bounds = unite(bounds, Bounds3(p, p));
-    candidates.push_back({bounds, false});
+    const bool solid = meshMedium[m] != kNoMedium;
+    anySolid = anySolid || solid;
+    candidates.push_back({bounds, solid});
   }
+  if (!anySolid) return false;
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.bounds.lo.x < b.bounds.lo.x; });
   constexpr std::size_t kTestBudget = std::size_t{1} << 24;
@@ -195,6 +247,14 @@ bool Scene::intersect(const Ray& ray, double tMax, Hit& hit, MediumStack& media)
 }
 
 Color Scene::transmittance(const Ray& ray, double tMax, const MediumStack& start) const {
+  if (mediaKtInUnitInterval_) {
+    // Every crossing keeps at most 1 of each channel and a medium's more than 0, so a product over
+    // all crossings of exactly 1 (nothing that dims in the way) or 0 (something that is not a
+    // medium, hence always a surface, blocks; barring underflow) is also the product over the
+    // crossings that are surfaces. Only the rays in between need the ordered walk.
+    const Color all = aggregate_.transmittance(ray, 0, tMax);
+    if (all == Color(1) || isBlack(all)) return all;
+  }
   MediumStack media = start;
   Color result(1);
   Ray segment = ray;
@@ -268,11 +328,31 @@ void Scene::initialiseMedia() {
         !isBlack(materials_[material].kt) && std::visit(BoundsVolume{}, primitive.shape());
     primitiveMedium_.push_back(medium ? material : kNoMedium);
   }
+  const std::vector<TriangleMesh>& meshes = aggregate_.meshes();
+  meshMedium_.reserve(meshes.size());
+  for (const TriangleMesh& mesh : meshes) {
+    const std::uint32_t material = mesh.materialIndex;
+    const bool medium = !isBlack(materials_[material].kt) && meshBoundsVolume(mesh);
+    meshMedium_.push_back(medium ? material : kNoMedium);
+  }
   materialTransmission_.reserve(materials_.size());
   for (const Material& material : materials_) {
     materialTransmission_.push_back(shadowTransmission(material, textures_, materialTextures_));
   }
-  nestedMedia_ = transparentSolidsOverlap(primitives, aggregate_.meshes(), materials_);
+  nestedMedia_ =
+      transparentSolidsOverlap(primitives, primitiveMedium_, meshes, meshMedium_, materials_);
+  // The shortcut of transmittance(ray, tMax, media): no material's shadow kt exceeds 1 in any
+  // channel, and no medium's is 0 in any.
+  const auto atMostOne = [](const Color& kt) { return kt.r <= 1 && kt.g <= 1 && kt.b <= 1; };
+  const auto positiveMedium = [&](std::uint32_t medium) {
+    if (medium == kNoMedium) return true;
+    const Color& kt = materialTransmission_[medium];
+    return kt.r > 0 && kt.g > 0 && kt.b > 0;
+  };
+  mediaKtInUnitInterval_ =
+      std::all_of(materialTransmission_.begin(), materialTransmission_.end(), atMostOne) &&
+      std::all_of(primitiveMedium_.begin(), primitiveMedium_.end(), positiveMedium) &&
+      std::all_of(meshMedium_.begin(), meshMedium_.end(), positiveMedium);
   if (!nestedMedia_) return;
 
   // The camera's media: march along its view direction through every surface; a solid whose first

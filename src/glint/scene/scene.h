@@ -192,11 +192,12 @@ class Scene {
   }
 
   // ---- Nested dielectrics (DESIGN.md §11, scene/media.h) ----
-  // A transparent solid is a sphere, box, cylinder or tube whose material has kt > 0; its medium
-  // is its material. Rays track the media they are inside only when some transparent solid's
-  // bounds overlap another transparent object's: otherwise no ray can be inside two media at once
-  // or meet a boundary that is no surface, every surface refracts against air exactly as the
-  // queries above assume, and the renderer uses them unchanged.
+  // A transparent solid is a sphere, box, cylinder, tube or closed mesh (closed and consistently
+  // oriented, outward) whose material has kt > 0; its medium is its material. Rays track the media
+  // they are inside only when some transparent solid's bounds overlap another transparent object's:
+  // otherwise no ray can be inside two media at once or meet a boundary that is no surface, every
+  // surface refracts against air exactly as the queries above assume, and the renderer uses them
+  // unchanged.
   bool nestedMedia() const { return nestedMedia_; }
   // The media the camera's position is inside (nestedMedia only, else empty): the transparent
   // solids that the ray from the camera along its view direction leaves before entering, the one it
@@ -207,8 +208,8 @@ class Scene {
   // when nestedMedia().
   // Objects inside instances are no media: they refract against the medium around them.
   std::uint32_t mediumOf(const Hit& hit) const {
-    return hit.mesh == kNoMesh && hit.instance == kNoInstance ? primitiveMedium_[hit.primitive]
-                                                              : kNoMedium;
+    if (hit.instance != kNoInstance) return kNoMedium;
+    return hit.mesh == kNoMesh ? primitiveMedium_[hit.primitive] : meshMedium_[hit.mesh];
   }
   // The boundary a ray with unit `direction` inside `media` meets at `hit` (crossBoundary).
   Boundary boundaryAt(const Hit& hit, const Vec3& direction, const MediumStack& media,
@@ -256,8 +257,12 @@ class Scene {
   std::vector<LightSurface> lightSurfaces_;
   bool nestedMedia_ = false;
   std::vector<std::uint32_t> primitiveMedium_;  // per primitive: mediumOf
+  std::vector<std::uint32_t> meshMedium_;       // per mesh: mediumOf
   std::vector<Color> materialTransmission_;     // per material: the kt a shadow ray keeps
   MediumStack cameraMedia_;
+  // Every material's shadow kt is at most 1 and every medium's above 0 in each channel:
+  // transmittance(ray, tMax, media) may answer from the order-free query when it gives 1 or 0.
+  bool mediaKtInUnitInterval_ = false;
 };
 
 }  // namespace glint
