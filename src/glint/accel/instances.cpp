@@ -16,6 +16,7 @@
 
 #include "glint/accel/slab_test.h"
 #include "glint/core/spawn.h"
+#include "glint/geometry/object_space.h"
 
 namespace glint {
 
@@ -78,30 +79,9 @@ Bounds3 worldBounds(const AffineMatrix& a, const Bounds3& b) {
 }
 
 // Error bound of worldFromGroup(p) for a group-space point p with error bound e: the bound a
-// transformed Primitive gives its hit points (shapes.cpp, worldPointError; pbrt-v4 §6.8.6 with the
-// round trip through the stored inverse), computed identically.
+// transformed Primitive gives its hit points, by the same function (geometry/object_space.h).
 Vec3 worldPointError(const Instance& in, const Point3& p, const Vec3& e, const Point3& world) {
-  const auto& m = in.worldFromGroup.m;
-  const auto& inv = in.groupFromWorld.m;
-  double kappa = 0;
-  double translation = 0;
-  for (int i = 0; i < 3; ++i) {
-    double row = 0;
-    for (int j = 0; j < 3; ++j)
-      for (int k = 0; k < 3; ++k) row += std::abs(m[i][k]) * std::abs(inv[k][j]);
-    kappa = std::max(kappa, row);
-    translation = std::max(translation, std::abs(m[i][3]));
-  }
-  const double roundTrip = gammaBound(8) * kappa * (maxComponent(abs(toVec(world))) + translation);
-  Vec3 out;
-  for (int i = 0; i < 3; ++i) {
-    const double carried =
-        std::abs(m[i][0]) * e.x + std::abs(m[i][1]) * e.y + std::abs(m[i][2]) * e.z;
-    const double rounding = std::abs(m[i][0] * p.x) + std::abs(m[i][1] * p.y) +
-                            std::abs(m[i][2] * p.z) + std::abs(m[i][3]);
-    out[i] = (1 + gammaBound(3)) * carried + gammaBound(3) * rounding + roundTrip;
-  }
-  return out;
+  return worldPointErrorOf(in.worldFromGroup.m, in.groupFromWorld.m, p, e, world);
 }
 
 }  // namespace

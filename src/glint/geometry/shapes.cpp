@@ -945,34 +945,11 @@ void requireInvertibleAffine(const Transform& transform) {
                      fmt::format("transform must be invertible, got determinant {}", det));
 }
 
-// Error bound of worldFromObject(p) for an object-space point p with error bound e (pbrt-v4
-// §6.8.6: (1 + γ3)·|M|·e + γ3·(|M|·|p| + |translation|)), plus the round trip: a ray spawned near
-// the world point is mapped back by the stored inverse, whose rounding (γ3 of |M⁻¹|·|o|) and
-// inexactness as an inverse, carried back to world space, grow with the condition number
-// κ = ‖|M|·|M⁻¹|‖∞ of the linear part (1 for scales, ≤ 3 for rotations).
+// Error bound of worldFromObject(p): worldPointErrorOf (object_space.h) on its two matrices.
 Vec3 worldPointError(const Transform& worldFromObject, const Point3& p, const Vec3& e,
                      const Point3& world) {
-  const auto& m = worldFromObject.matrix().m;
-  const auto& inv = worldFromObject.inverseMatrix().m;
-  double kappa = 0;
-  double translation = 0;
-  for (int i = 0; i < 3; ++i) {
-    double row = 0;
-    for (int j = 0; j < 3; ++j)
-      for (int k = 0; k < 3; ++k) row += std::abs(m[i][k]) * std::abs(inv[k][j]);
-    kappa = std::max(kappa, row);
-    translation = std::max(translation, std::abs(m[i][3]));
-  }
-  const double roundTrip = gammaBound(8) * kappa * (maxComponent(abs(toVec(world))) + translation);
-  Vec3 out;
-  for (int i = 0; i < 3; ++i) {
-    const double carried =
-        std::abs(m[i][0]) * e.x + std::abs(m[i][1]) * e.y + std::abs(m[i][2]) * e.z;
-    const double rounding = std::abs(m[i][0] * p.x) + std::abs(m[i][1] * p.y) +
-                            std::abs(m[i][2] * p.z) + std::abs(m[i][3]);
-    out[i] = (1 + gammaBound(3)) * carried + gammaBound(3) * rounding + roundTrip;
-  }
-  return out;
+  return worldPointErrorOf(worldFromObject.matrix().m, worldFromObject.inverseMatrix().m, p, e,
+                           world);
 }
 
 // objectFromWorld applied to a ray: the inverse matrix of worldFromObject, with the same arithmetic
