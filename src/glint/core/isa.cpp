@@ -32,10 +32,24 @@ IsaSupport isaSupportHere() {
 #if GLINT_ISA_KERNELS
   support.compiled[static_cast<int>(Isa::Avx2)] = true;
   support.compiled[static_cast<int>(Isa::Avx512)] = true;
-  // GCC's CPU model checks CPUID and that the OS saves the AVX and AVX-512 registers (XGETBV).
+  // The compiler's CPU model checks CPUID and that the OS saves the AVX and AVX-512 registers
+  // (XGETBV).
   __builtin_cpu_init();
-  support.cpu[static_cast<int>(Isa::Avx2)] = __builtin_cpu_supports("x86-64-v3") != 0;
-  support.cpu[static_cast<int>(Isa::Avx512)] = __builtin_cpu_supports("x86-64-v4") != 0;
+#if defined(__clang__)
+  // clang 14 (Debian 12's, used by the fuzz build) cannot name the levels: their defining
+  // features instead. Every processor with these also has the level's LZCNT, MOVBE and F16C
+  // (Haswell, Excavator, Zen and later), which g++'s level names check too.
+  const bool v3 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+                  __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+  const bool v4 = v3 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+                  __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512dq") &&
+                  __builtin_cpu_supports("avx512vl");
+#else
+  const bool v3 = __builtin_cpu_supports("x86-64-v3") != 0;
+  const bool v4 = __builtin_cpu_supports("x86-64-v4") != 0;
+#endif
+  support.cpu[static_cast<int>(Isa::Avx2)] = v3;
+  support.cpu[static_cast<int>(Isa::Avx512)] = v4;
 #endif
   return support;
 }
