@@ -188,7 +188,7 @@ int run(int argc, char** argv) {
   }
   std::printf(
       "\nMrays/s: closest hit of 1024x768 camera rays across the field, all hardware threads.\n"
-      "memoryBytes: the aggregate's own count (200 B per instance record + the top-level tree +\n"
+      "memoryBytes: the aggregate's own count (104 B per instance record + the top-level tree +\n"
       "the torus group once); heap: mallinfo2 bytes in use after - before the build, plus the\n"
       "group. Flattened 10^3 instances would be 10^8 triangles (~6 GB): not run.\n");
   std::printf("load average at the end: %s\n", loadAverage().c_str());

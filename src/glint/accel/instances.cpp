@@ -65,6 +65,8 @@ Normal3 applyToNormal(const AffineMatrix& inverse, const Normal3& n) {
           mi[0][2] * n.x + mi[1][2] * n.y + mi[2][2] * n.z};
 }
 
+PlacedInstance placed(const Instance& in) { return {in.groupFromWorld, in.group, in.material}; }
+
 // The world bounds of a group-space box: its eight corners mapped (Transform's bounds).
 Bounds3 worldBounds(const AffineMatrix& a, const Bounds3& b) {
   if (b.isEmpty()) return b;
@@ -78,10 +80,71 @@ Bounds3 worldBounds(const AffineMatrix& a, const Bounds3& b) {
   return result;
 }
 
-// Error bound of worldFromGroup(p) for a group-space point p with error bound e: the bound a
-// transformed Primitive gives its hit points, by the same function (geometry/object_space.h).
-Vec3 worldPointError(const Instance& in, const Point3& p, const Vec3& e, const Point3& world) {
-  return worldPointErrorOf(in.worldFromGroup.m, in.groupFromWorld.m, p, e, world);
+// The world-from-group map of an instance, re-derived from the stored inverse [B | c]: the linear
+// part by the adjugate formula B⁻¹ = adj(B) / det(B), the translation −B⁻¹·c. Deterministic, so
+// every hit on the instance gets the same matrix; it differs from the Transform's own forward
+// matrix in the last bits (bounded in worldPointError below).
+AffineMatrix forwardOf(const AffineMatrix& inverse) {
+  const auto& b = inverse.m;
+  const double c00 = b[1][1] * b[2][2] - b[1][2] * b[2][1];
+  const double c01 = b[1][2] * b[2][0] - b[1][0] * b[2][2];
+  const double c02 = b[1][0] * b[2][1] - b[1][1] * b[2][0];
+  const double c10 = b[0][2] * b[2][1] - b[0][1] * b[2][2];
+  const double c11 = b[0][0] * b[2][2] - b[0][2] * b[2][0];
+  const double c12 = b[0][1] * b[2][0] - b[0][0] * b[2][1];
+  const double c20 = b[0][1] * b[1][2] - b[0][2] * b[1][1];
+  const double c21 = b[0][2] * b[1][0] - b[0][0] * b[1][2];
+  const double c22 = b[0][0] * b[1][1] - b[0][1] * b[1][0];
+  const double det = b[0][0] * c00 + b[0][1] * c01 + b[0][2] * c02;
+  AffineMatrix f;
+  auto& a = f.m;
+  // adj(B) is the transpose of the cofactor matrix.
+  a[0][0] = c00 / det;
+  a[0][1] = c10 / det;
+  a[0][2] = c20 / det;
+  a[1][0] = c01 / det;
+  a[1][1] = c11 / det;
+  a[1][2] = c21 / det;
+  a[2][0] = c02 / det;
+  a[2][1] = c12 / det;
+  a[2][2] = c22 / det;
+  for (int i = 0; i < 3; ++i) {
+    a[i][3] = -(a[i][0] * b[0][3] + a[i][1] * b[1][3] + a[i][2] * b[2][3]);
+  }
+  return f;
+}
+
+// Error bound of the world point forward·p for a group-space point p with error bound e, `world`
+// being forward·p and `forward` = forwardOf(in.groupFromWorld): the bound a transformed Primitive
+// gives its hit points (geometry/object_space.h, same function), plus the derived matrix's own
+// error as an inverse of the stored one. The adjugate inverse of a 3×3 matrix is componentwise
+// accurate to a small multiple of the unit roundoff times the condition number
+// κ = ‖|A|·|B|‖∞ (1 for scales, ≤ 3 for rotations); taken as γ24·κ, and carried through the
+// translation −A·c, whose own rounding adds γ3·|A|·|c|.
+Vec3 worldPointError(const PlacedInstance& in, const AffineMatrix& forward, const Point3& p,
+                     const Vec3& e, const Point3& world) {
+  Vec3 out = worldPointErrorOf(forward.m, in.groupFromWorld.m, p, e, world);
+  const auto& a = forward.m;
+  const auto& b = in.groupFromWorld.m;
+  double kappa = 0;
+  for (int i = 0; i < 3; ++i) {
+    double row = 0;
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) row += std::abs(a[i][k]) * std::abs(b[k][j]);
+    kappa = std::max(kappa, row);
+  }
+  const double derivation = gammaBound(24) * kappa;
+  const double pAbs[3] = {std::abs(p.x), std::abs(p.y), std::abs(p.z)};
+  for (int i = 0; i < 3; ++i) {
+    double linear = 0;
+    double translation = 0;
+    for (int j = 0; j < 3; ++j) {
+      linear += std::abs(a[i][j]) * pAbs[j];
+      translation += std::abs(a[i][j]) * std::abs(b[j][3]);
+    }
+    out[i] += derivation * (linear + translation) + gammaBound(3) * translation;
+  }
+  return out;
 }
 
 }  // namespace
@@ -156,7 +219,7 @@ InstanceSet::InstanceSet(std::vector<std::shared_ptr<const Aggregate>> groups,
   });
   std::vector<bvh::BuildItem> items;
   items.reserve(n);
-  std::vector<Instance> unboundedInstances;
+  std::vector<PlacedInstance> unboundedInstances;
   for (std::size_t i = 0; i < n; ++i) {
     if (kind[i] == 1) {
       items.push_back(slots[i]);
@@ -164,7 +227,7 @@ InstanceSet::InstanceSet(std::vector<std::shared_ptr<const Aggregate>> groups,
       bounds_ = unite(bounds_, Bounds3(Point3{item.lo[0], item.lo[1], item.lo[2]},
                                        Point3{item.hi[0], item.hi[1], item.hi[2]}));
     } else if (kind[i] == 2) {
-      unboundedInstances.push_back(instances[i]);
+      unboundedInstances.push_back(placed(instances[i]));
     }
   }
   std::vector<bvh::BuildItem>().swap(slots);
@@ -177,9 +240,11 @@ InstanceSet::InstanceSet(std::vector<std::shared_ptr<const Aggregate>> groups,
   }
   // The instances in leaf order (leaves already point at item positions), then the unbounded ones.
   instances_.reserve(items.size() + unboundedInstances.size());
-  for (const bvh::BuildItem& item : items) instances_.push_back(instances[bvh::itemIndex(item)]);
+  for (const bvh::BuildItem& item : items) {
+    instances_.push_back(placed(instances[bvh::itemIndex(item)]));
+  }
   std::vector<Instance>().swap(instances);
-  for (const Instance& in : unboundedInstances) {
+  for (const PlacedInstance& in : unboundedInstances) {
     unbounded_.push_back(static_cast<std::uint32_t>(instances_.size()));
     instances_.push_back(in);
   }
@@ -188,7 +253,7 @@ InstanceSet::InstanceSet(std::vector<std::shared_ptr<const Aggregate>> groups,
 
 bool InstanceSet::intersectInstance(std::uint32_t i, const Ray& ray, double tMin, double tMax,
                                     Hit& local, Ray& groupRay) const {
-  const Instance& in = instances_[i];
+  const PlacedInstance& in = instances_[i];
   // The group-space direction is not normalised, so t is the same in both spaces.
   groupRay = Ray{applyToPoint(in.groupFromWorld, ray.origin),
                  applyToVector(in.groupFromWorld, ray.direction)};
@@ -196,15 +261,16 @@ bool InstanceSet::intersectInstance(std::uint32_t i, const Ray& ray, double tMin
 }
 
 void InstanceSet::finishHit(std::uint32_t i, const Ray& /*groupRay*/, Hit& hit) const {
-  const Instance& in = instances_[i];
+  const PlacedInstance& in = instances_[i];
   const bool smooth = !(hit.shadingNormal == hit.normal);
   hit.normal = Normal3(normalize(toVec(applyToNormal(in.groupFromWorld, hit.normal))));
   hit.shadingNormal =
       smooth ? Normal3(normalize(toVec(applyToNormal(in.groupFromWorld, hit.shadingNormal))))
              : hit.normal;
   const Point3 groupPoint = hit.point;
-  hit.point = applyToPoint(in.worldFromGroup, groupPoint);
-  hit.pointError = worldPointError(in, groupPoint, hit.pointError, hit.point);
+  const AffineMatrix forward = forwardOf(in.groupFromWorld);
+  hit.point = applyToPoint(forward, groupPoint);
+  hit.pointError = worldPointError(in, forward, groupPoint, hit.pointError, hit.point);
   hit.instance = i;
 }
 
@@ -292,7 +358,7 @@ bool InstanceSet::intersect(const Ray& ray, double tMin, double tMax, Hit& hit) 
 Color InstanceSet::transmittance(const Ray& ray, double tMin, double tMax) const {
   Color result(1);
   const auto cross = [&](std::uint32_t i) {
-    const Instance& in = instances_[i];
+    const PlacedInstance& in = instances_[i];
     const Ray groupRay{applyToPoint(in.groupFromWorld, ray.origin),
                        applyToVector(in.groupFromWorld, ray.direction)};
     const Color t = groups_[in.group]->transmittance(groupRay, tMin, tMax);
@@ -348,7 +414,7 @@ Point3 InstanceSet::groupPoint(std::uint32_t i, const Point3& world) const {
 }
 
 Vec3 InstanceSet::worldVector(std::uint32_t i, const Vec3& v) const {
-  return applyToVector(instances_[i].worldFromGroup, v);
+  return applyToVector(forwardOf(instances_[i].groupFromWorld), v);
 }
 
 Normal3 InstanceSet::worldNormal(std::uint32_t i, const Normal3& n) const {
@@ -363,7 +429,8 @@ Color InstanceSet::vertexColor(const Hit& hit) const {
 }
 
 std::size_t InstanceSet::memoryBytes() const {
-  std::size_t bytes = instances_.capacity() * sizeof(Instance) + nodes_.capacity() * sizeof(Node) +
+  std::size_t bytes = instances_.capacity() * sizeof(PlacedInstance) +
+                      nodes_.capacity() * sizeof(Node) +
                       unbounded_.capacity() * sizeof(std::uint32_t) +
                       groups_.capacity() * sizeof(std::shared_ptr<const Aggregate>);
   for (const auto& g : groups_) bytes += g->memoryBytes();

@@ -26,8 +26,9 @@ struct AffineMatrix {
   double m[3][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}};
 };
 
-// One placed group: 200 bytes, so a million instances hold 200 MB of records (the tree's nodes
-// come on top; the groups' geometry is shared).
+// One placement of a group as the scene gives it: the world-from-group map and its inverse as
+// Transform computed them. The build input of an InstanceSet (200 bytes); the set keeps only the
+// inverse (PlacedInstance).
 struct Instance {
   AffineMatrix worldFromGroup;
   AffineMatrix groupFromWorld;  // the inverse, as Transform computed it (not re-derived)
@@ -36,7 +37,19 @@ struct Instance {
   // kNoMaterialOverride; the Scene resolves it (the InstanceSet only carries it).
   std::uint32_t material = kNoMaterialOverride;
 };
-static_assert(sizeof(Instance) == 200);
+
+// What an InstanceSet stores per instance: 104 bytes, so a million instances hold 104 MB of
+// records (the tree's nodes come on top; the groups' geometry is shared). Only the inverse is
+// kept: it maps every ray entering the instance, so which surface a ray hits and at which t are
+// exactly what the transformed objects give. The forward map, needed once per closest hit (the
+// world hit point, tangents), is re-derived from the inverse (adjugate formula); the hit point's
+// error bound includes that derivation's error (instances.cpp).
+struct PlacedInstance {
+  AffineMatrix groupFromWorld;
+  std::uint32_t group = 0;
+  std::uint32_t material = kNoMaterialOverride;
+};
+static_assert(sizeof(PlacedInstance) == 104);
 
 // The instance record of a transform (identity when absent). Throws std::invalid_argument when the
 // transform is not a finite, invertible affine map.
@@ -60,7 +73,7 @@ class InstanceSet {
   // Product of kt over every crossing of an instance's surfaces in (tMin, tMax).
   Color transmittance(const Ray& ray, double tMin, double tMax) const;
 
-  const Instance& instance(std::uint32_t i) const { return instances_[i]; }
+  const PlacedInstance& instance(std::uint32_t i) const { return instances_[i]; }
   std::size_t instanceCount() const { return instances_.size(); }
   const Aggregate& group(std::uint32_t g) const { return *groups_[g]; }
   std::size_t groupCount() const { return groups_.size(); }
@@ -82,8 +95,8 @@ class InstanceSet {
   void finishHit(std::uint32_t i, const Ray& groupRay, Hit& hit) const;
 
   std::vector<std::shared_ptr<const Aggregate>> groups_;
-  std::vector<Instance> instances_;       // in leaf order: a leaf is a range of them
-  std::vector<std::uint32_t> unbounded_;  // instances of groups with planes or tubes: every ray
+  std::vector<PlacedInstance> instances_;  // in leaf order: a leaf is a range of them
+  std::vector<std::uint32_t> unbounded_;   // instances of groups with planes or tubes: every ray
   std::vector<bvh::Node> nodes_;
   std::uint32_t rootChild_ = 0;
   std::uint32_t rootInfo_ = bvh::kEmpty;

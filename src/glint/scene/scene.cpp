@@ -387,7 +387,7 @@ void Scene::initialiseMedia() {
 }
 
 std::uint32_t Scene::instancedMaterialIndex(const Hit& hit) const {
-  const Instance& in = aggregate_.instances()->instance(hit.instance);
+  const PlacedInstance& in = aggregate_.instances()->instance(hit.instance);
   const GroupMaterialTakers& takers = groupTakesMaterial_[in.group];
   const bool takes =
       hit.mesh == kNoMesh ? takers.primitives[hit.primitive] != 0 : takers.meshes[hit.mesh] != 0;
