@@ -172,6 +172,30 @@ TEST(Instancing, InstanceMaterialReplacesOnlyMissingMaterials) {
                   renderText(writtenOut(object + ", material: glass")));
 }
 
+// A csg's shadow counts each crossing of its surface with the crossed operand's kt (csg.h); inside
+// a group as in the world. Here the glass sphere's shadow on the floor falls through the glass
+// operand and the red (opaque) one's, and an instance's material given to a csg without one
+// reaches every operand's shadow too.
+TEST(Instancing, ATransparentCsgCastsTheSameShadowInAGroup) {
+  const std::string csg =
+      "type: csg, operation: union, operands: [{type: sphere, center: [-0.5, 0.2, 0], radius: "
+      "0.8, material: glass}, {type: box, min: [0.2, -0.4, -0.4], max: [1.2, 0.6, 0.4], "
+      "material: red}]";
+  const Film empty = renderText(kStage + "objects:\n" + kFloor);
+  const Film expected = renderText(writtenOut(csg));
+  expectSameBytes(renderText(instanced(csg)), expected);
+  EXPECT_GT(litPixels(expected, empty), 500u);
+  // The same union without operand materials, glass given by the instance.
+  const std::string open =
+      "type: csg, operation: union, operands: [{type: sphere, center: [-0.5, 0.2, 0], radius: "
+      "0.8}, {type: box, min: [0.2, -0.4, -0.4], max: [1.2, 0.6, 0.4]}]";
+  const std::string closed =
+      "type: csg, operation: union, material: glass, operands: [{type: sphere, center: [-0.5, "
+      "0.2, 0], radius: 0.8}, {type: box, min: [0.2, -0.4, -0.4], max: [1.2, 0.6, 0.4]}]";
+  expectSameBytes(renderText(instanced(open, ", material: glass")),
+                  renderText(writtenOut(closed)));
+}
+
 TEST(Instancing, SolidTexturesFollowTheInstance) {
   const std::string stage = kStage +
                             "textures:\n  checks: {type: checker, scale: 0.5, "

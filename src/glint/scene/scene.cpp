@@ -83,24 +83,10 @@ Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materia
   for (std::size_t i = 0; i < parts.primitives.size(); ++i) {
     Primitive& primitive = parts.primitives[i];
     const Color kt = checkMaterial("primitive", i, primitive.materialIndex());
-    const Csg* csg = primitive.csg();
-    if (csg == nullptr) {
-      transmission.push_back(kt);
-      continue;
-    }
-    // A csg's operands carry their own kt; the primitive's says only whether any dims a shadow ray.
-    std::vector<Color> operandTransmission;
-    bool clear = true;
-    for (const CsgOperand& operand : csg->tree->operands) {
-      operandTransmission.push_back(
-          checkMaterial("csg operand of primitive", i, operand.materialIndex));
-      clear = clear && operandTransmission.back() == Color(1);
-    }
-    const Transform* transform = primitive.worldFromObject();
-    primitive = Primitive(withCsgTransmission(*csg, operandTransmission), primitive.materialIndex(),
-                          primitive.emission(),
-                          transform ? std::optional<Transform>(*transform) : std::nullopt);
-    transmission.push_back(clear ? Color(1) : Color());
+    const std::optional<Color> csgKt = setCsgTransmission(primitive, [&](std::uint32_t material) {
+      return checkMaterial("csg operand of primitive", i, material);
+    });
+    transmission.push_back(csgKt ? *csgKt : kt);
   }
   std::vector<Color> meshTransmission;
   meshTransmission.reserve(parts.meshes.size());

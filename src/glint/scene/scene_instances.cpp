@@ -2,6 +2,8 @@
 // the instances placed on them.
 #include "glint/scene/scene_instances.h"
 
+#include "glint/geometry/csg.h"
+
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -26,6 +28,23 @@ void checkMaterial(std::uint32_t material, std::size_t count, const std::string&
 
 }  // namespace
 
+std::optional<Color> setCsgTransmission(
+    Primitive& primitive, const std::function<Color(std::uint32_t material)>& operandKt) {
+  const Csg* csg = primitive.csg();
+  if (csg == nullptr) return std::nullopt;
+  std::vector<Color> operandTransmission;
+  bool clear = true;
+  for (const CsgOperand& operand : csg->tree->operands) {
+    operandTransmission.push_back(operandKt(operand.materialIndex));
+    clear = clear && operandTransmission.back() == Color(1);
+  }
+  const Transform* transform = primitive.worldFromObject();
+  primitive = Primitive(withCsgTransmission(*csg, operandTransmission), primitive.materialIndex(),
+                        primitive.emission(),
+                        transform ? std::optional<Transform>(*transform) : std::nullopt);
+  return clear ? Color(1) : Color();
+}
+
 std::shared_ptr<const InstanceSet> buildInstanceSet(SceneParts& parts,
                                                     const std::vector<Material>& materials,
                                                     const std::vector<Texture>& textures,
@@ -49,6 +68,12 @@ std::shared_ptr<const InstanceSet> buildInstanceSet(SceneParts& parts,
       checkMaterial(group.primitives[i].materialIndex(), materials.size(),
                     name + " primitive " + std::to_string(i));
       primitiveKt[g].push_back(kt(group.primitives[i].materialIndex()));
+      if (const Csg* csg = group.primitives[i].csg()) {
+        for (const CsgOperand& operand : csg->tree->operands) {
+          checkMaterial(operand.materialIndex, materials.size(),
+                        name + " csg operand of primitive " + std::to_string(i));
+        }
+      }
     }
     for (std::size_t m = 0; m < group.meshes.size(); ++m) {
       checkMaterial(group.meshes[m].materialIndex, materials.size(),
@@ -75,8 +100,13 @@ std::shared_ptr<const InstanceSet> buildInstanceSet(SceneParts& parts,
       const Color given = kt(in.material);
       const GroupParts& group = parts.groups[in.group];
       for (std::size_t i = 0; i < group.primitives.size() && !override; ++i) {
-        if (takes(group.primitiveTakesMaterial, i) && !(primitiveKt[in.group][i] == given)) {
-          override = given;
+        if (!takes(group.primitiveTakesMaterial, i)) continue;
+        if (!(primitiveKt[in.group][i] == given)) override = given;
+        // A csg that takes the material takes it for every operand (Scene::materialIndexOf).
+        if (const Csg* csg = group.primitives[i].csg()) {
+          for (const CsgOperand& operand : csg->tree->operands) {
+            if (!(kt(operand.materialIndex) == given)) override = given;
+          }
         }
       }
       for (std::size_t m = 0; m < group.meshes.size() && !override; ++m) {
@@ -110,12 +140,22 @@ std::shared_ptr<const InstanceSet> buildInstanceSet(SceneParts& parts,
     t.primitives.resize(group.primitives.size(), 0);
     t.meshes.resize(group.meshes.size(), 0);
     takers.push_back(std::move(t));
+    std::vector<Primitive> primitives =
+        lastUse[g] == r ? std::move(group.primitives) : group.primitives;
+    for (std::size_t i = 0; i < primitives.size(); ++i) {
+      const bool overridden = override && takes(group.primitiveTakesMaterial, i);
+      const std::optional<Color> csgKt =
+          setCsgTransmission(primitives[i], [&](std::uint32_t material) {
+            return overridden ? *override : kt(material);  // indices checked above
+          });
+      if (csgKt) pKt[i] = *csgKt;
+    }
     std::shared_ptr<Aggregate> aggregate =
         lastUse[g] == r
-            ? std::make_shared<Aggregate>(std::move(group.primitives), std::move(pKt),
+            ? std::make_shared<Aggregate>(std::move(primitives), std::move(pKt),
                                           std::move(group.meshes), std::move(mKt),
                                           parts.acceleration)
-            : std::make_shared<Aggregate>(group.primitives, std::move(pKt), group.meshes,
+            : std::make_shared<Aggregate>(std::move(primitives), std::move(pKt), group.meshes,
                                           std::move(mKt), parts.acceleration);
     if (parts.isa) aggregate->setIsa(*parts.isa);  // the groups' queries run as the scene's
     aggregates.push_back(std::move(aggregate));

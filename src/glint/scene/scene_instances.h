@@ -2,7 +2,9 @@
 // InstanceSet its Aggregate queries, with the shadow transmission of every group object.
 #pragma once
 
+#include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "glint/accel/instances.h"
@@ -20,6 +22,14 @@ std::shared_ptr<const InstanceSet> buildInstanceSet(SceneParts& parts,
                                                     const std::vector<Texture>& textures,
                                                     const std::vector<MaterialTextures>& bindings,
                                                     std::vector<GroupMaterialTakers>& takers);
+
+// A csg's shadow transmission, for the world's primitives and the groups' alike: each operand
+// gets operandKt(its material index) on a copy of the operand tree (the primitive is rebuilt), and
+// the primitive's own transmission is returned: Color(1) when every operand is clear, black
+// otherwise (the Aggregate then asks the csg, which counts each crossing of the result's surface
+// with the crossed operand's kt). std::nullopt, the primitive untouched, when it is not a csg.
+std::optional<Color> setCsgTransmission(
+    Primitive& primitive, const std::function<Color(std::uint32_t material)>& operandKt);
 
 // The factor a shadow ray keeps crossing a surface of `material`: kt, times the mean of kt's
 // texture (a shadow ray has no (u, v) to look one up at).
