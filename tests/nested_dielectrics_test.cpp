@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "glint/core/rng.h"
 #include "glint/core/spawn.h"
 #include "glint/factories/scene_loader.h"
 #include "glint/factories/scene_test_support.h"
@@ -134,6 +135,54 @@ TEST(NestedDielectrics, ShadowRayKeepsOneSolidsTransmittanceAcrossASameMaterialB
   // An opaque blocker still stops it.
   const Scene blocked = sceneOf(concentricSpheres("{kd: 1}"));
   EXPECT_EQ(blocked.transmittance(through, kInfinity, MediumStack{}), Color());
+}
+
+// Shadow rays in scenes with nested media take the order-free query when no boundary can be "no
+// surface" (spheres of distinct materials strictly inside one another), and walk the crossings
+// otherwise. Two partly overlapping spheres of distinct materials are the case the shortcut must
+// not take: leaving the first inside the second (entered later, equal priority) is no surface.
+TEST(NestedDielectrics, PartlyOverlappingSolidsOfDistinctMaterialsCountOnlyTheirSurfaces) {
+  const Scene overlap = sceneOf(std::string(testing::kMinimal) + R"(materials:
+  glass: {kt: 0.8, ior: 1.5}
+  tinted: {kt: 0.5, ior: 1.5}
+objects:
+  - {type: sphere, center: [-0.5, 0, 0], radius: 1, material: glass}
+  - {type: sphere, center: [0.5, 0, 0], radius: 1, material: tinted}
+)");
+  ASSERT_TRUE(overlap.nestedMedia());
+  const Ray through{{-3, 0, 0}, {1, 0, 0}};
+  // Into the glass (0.8), into the tinted (0.5), out of the glass inside the tinted (no surface),
+  // out of the tinted (0.5).
+  EXPECT_NEAR(overlap.transmittance(through, kInfinity, MediumStack{}).r, 0.8 * 0.5 * 0.5, 1e-15);
+  // Strictly nested distinct materials: every crossing is a surface (the shortcut's case), so a
+  // ray keeps 0.8 per crossing of the outer sphere and 0.5 per crossing of the inner one.
+  const Scene nested = sceneOf(concentricSpheres("tinted"));
+  const auto crossingsOf = [](const Ray& ray, double radius, double tMax) {
+    // |o + t·d|² = r² with |d| = 1: t = −b ± √(b² − c).
+    const double b = dot(toVec(ray.origin), ray.direction);
+    const double c = dot(toVec(ray.origin), toVec(ray.origin)) - radius * radius;
+    const double disc = b * b - c;
+    if (disc <= 0) return 0;
+    int n = 0;
+    for (const double t : {-b - std::sqrt(disc), -b + std::sqrt(disc)}) n += t > 0 && t < tMax;
+    return n;
+  };
+  Rng rng(3);
+  int throughBoth = 0;
+  for (int k = 0; k < 400; ++k) {
+    // From anywhere near the spheres (inside them too) towards a point near their centre.
+    const Point3 origin(4 * rng.uniform() - 2, 4 * rng.uniform() - 2, 4 * rng.uniform() - 2);
+    const Point3 target(0.8 * rng.uniform() - 0.4, 0.8 * rng.uniform() - 0.4,
+                        0.8 * rng.uniform() - 0.4);
+    const Ray ray{origin, normalize(target - origin)};
+    const int outer = crossingsOf(ray, 1, 10);
+    const int inner = crossingsOf(ray, 0.5, 10);
+    throughBoth += outer > 0 && inner > 0;
+    EXPECT_NEAR(nested.transmittance(ray, 10, MediumStack{}).r,
+                std::pow(0.8, outer) * std::pow(0.5, inner), 1e-14)
+        << "ray " << k;
+  }
+  EXPECT_GT(throughBoth, 100);
 }
 
 // A glass block with a water block inside it, the water's top face at y = 0 (a planar water–glass

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -214,6 +215,72 @@ bool transparentSolidsOverlap(const std::vector<Primitive>& primitives,
   return false;
 }
 
+// Whether, in a scene with nested media, every boundary a ray can meet is still a surface, so that
+// a shadow ray's product of kt over the surfaces it crosses is its product over all crossings (the
+// order-free Aggregate query). True when all media have one priority and every two transparent
+// solids whose bounds overlap are untransformed spheres of different materials, one strictly inside
+// the other: a ray then enters a solid only from a different medium of equal priority, and leaves
+// only the innermost solid it is in, into a different medium (media.h: both are surfaces). A solid
+// overlapping another in any other way (partly, of the same material, a mesh, a box) answers
+// false, conservatively: the walk one crossing at a time stays.
+bool everyBoundaryIsASurface(const std::vector<Primitive>& primitives,
+                             const std::vector<std::uint32_t>& primitiveMedium,
+                             const std::vector<TriangleMesh>& meshes,
+                             const std::vector<std::uint32_t>& meshMedium,
+                             const std::vector<Material>& materials) {
+  std::optional<int> priority;
+  const auto samePriority = [&](std::uint32_t medium) {
+    if (medium == kNoMedium) return true;
+    if (!priority) priority = materials[medium].priority;
+    return materials[medium].priority == *priority;
+  };
+  if (!std::all_of(primitiveMedium.begin(), primitiveMedium.end(), samePriority) ||
+      !std::all_of(meshMedium.begin(), meshMedium.end(), samePriority)) {
+    return false;
+  }
+  struct Solid {
+    Bounds3 bounds;
+    const Sphere* sphere;  // null: another solid
+    std::uint32_t medium;
+  };
+  std::vector<Solid> solids;
+  for (std::size_t i = 0; i < primitives.size(); ++i) {
+    if (primitiveMedium[i] == kNoMedium) continue;
+    const Sphere* sphere = primitives[i].worldFromObject() == nullptr
+                               ? std::get_if<Sphere>(&primitives[i].shape())
+                               : nullptr;
+    solids.push_back({primitives[i].bounds(), sphere, primitiveMedium[i]});
+  }
+  for (std::size_t m = 0; m < meshes.size(); ++m) {
+    if (meshMedium[m] == kNoMedium) continue;
+    Bounds3 bounds;
+    for (const Point3& p : meshes[m].positions) bounds = unite(bounds, Bounds3(p, p));
+    solids.push_back({bounds, nullptr, meshMedium[m]});
+  }
+  // A few solids overlap in the scenes this serves; past a budget of pairs the answer is no.
+  constexpr std::size_t kPairBudget = std::size_t{1} << 20;
+  if (solids.size() > 1 && solids.size() * (solids.size() - 1) / 2 > kPairBudget) return false;
+  constexpr double kMargin = 1e-9;  // relative: far above the offsets of spawned rays
+  for (std::size_t i = 0; i < solids.size(); ++i) {
+    for (std::size_t j = i + 1; j < solids.size(); ++j) {
+      const Solid& a = solids[i];
+      const Solid& b = solids[j];
+      const bool boundsOverlap = a.bounds.lo.x <= b.bounds.hi.x && b.bounds.lo.x <= a.bounds.hi.x &&
+                                 a.bounds.lo.y <= b.bounds.hi.y && b.bounds.lo.y <= a.bounds.hi.y &&
+                                 a.bounds.lo.z <= b.bounds.hi.z && b.bounds.lo.z <= a.bounds.hi.z;
+      if (!boundsOverlap) continue;
+      if (a.sphere == nullptr || b.sphere == nullptr || a.medium == b.medium) return false;
+      const double d = length(a.sphere->center - b.sphere->center);
+      const double big = std::max(a.sphere->radius, b.sphere->radius);
+      const double small = std::min(a.sphere->radius, b.sphere->radius);
+      const bool inside = d + small < big * (1 - kMargin);
+      const bool apart = d > (big + small) * (1 + kMargin);
+      if (!inside && !apart) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool Scene::intersect(const Ray& ray, double tMax, Hit& hit, MediumStack& media) const {
@@ -233,6 +300,7 @@ bool Scene::intersect(const Ray& ray, double tMax, Hit& hit, MediumStack& media)
 }
 
 Color Scene::transmittance(const Ray& ray, double tMax, const MediumStack& start) const {
+  if (boundariesAreSurfaces_) return aggregate_.transmittance(ray, 0, tMax);
   if (mediaKtInUnitInterval_) {
     // Every crossing keeps at most 1 of each channel and a medium's more than 0, so a product over
     // all crossings of exactly 1 (nothing that dims in the way) or 0 (something that is not a
@@ -340,6 +408,8 @@ void Scene::initialiseMedia() {
       std::all_of(primitiveMedium_.begin(), primitiveMedium_.end(), positiveMedium) &&
       std::all_of(meshMedium_.begin(), meshMedium_.end(), positiveMedium);
   if (!nestedMedia_) return;
+  boundariesAreSurfaces_ =
+      everyBoundaryIsASurface(primitives, primitiveMedium_, meshes, meshMedium_, materials_);
 
   // The camera's media: march along its view direction through every surface; a solid whose first
   // crossing leaves it contains the camera. (A thin lens's other ray origins are taken to lie in

@@ -263,6 +263,9 @@ class Scene {
   // Every material's shadow kt is at most 1 and every medium's above 0 in each channel:
   // transmittance(ray, tMax, media) may answer from the order-free query when it gives 1 or 0.
   bool mediaKtInUnitInterval_ = false;
+  // No boundary can be "no surface" (nested spheres of distinct materials, one priority):
+  // transmittance(ray, tMax, media) is the order-free query (everyBoundaryIsASurface in scene.cpp).
+  bool boundariesAreSurfaces_ = false;
 };
 
 }  // namespace glint
