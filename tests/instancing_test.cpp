@@ -104,17 +104,22 @@ std::size_t litPixels(const Film& film, const Film& background) {
   return n;
 }
 
-TEST(Instancing, SphereAndBoxInstancesRenderTheSameBytesAsTransformedObjects) {
+// `object` placed by an instance renders the bytes of `object` written out, and shows in the image
+// (it and its shadow and reflection change more than 500 pixels of the empty stage).
+void expectInstanceRendersAsWrittenOut(const std::string& object) {
+  SCOPED_TRACE(object);
   const Film empty = renderText(kStage + "objects:\n" + kFloor);
+  const Film expected = renderText(writtenOut(object));
+  expectSameBytes(renderText(instanced(object)), expected);
+  EXPECT_GT(litPixels(expected, empty), 500u);
+}
+
+TEST(Instancing, SphereAndBoxInstancesRenderTheSameBytesAsTransformedObjects) {
   for (const std::string& object :
        {std::string("type: sphere, center: [0, 0.2, 0], radius: 1, material: red"),
         std::string("type: box, min: [-1, -0.5, -0.7], max: [0.8, 1, 0.6], material: red"),
         std::string("type: sphere, center: [0, 0.2, 0], radius: 1, material: glass")}) {
-    SCOPED_TRACE(object);
-    const Film expected = renderText(writtenOut(object));
-    const Film actual = renderText(instanced(object));
-    expectSameBytes(actual, expected);
-    EXPECT_GT(litPixels(expected, empty), 500u);  // the object shows (and shadows, and reflects)
+    expectInstanceRendersAsWrittenOut(object);
   }
 }
 
@@ -123,11 +128,7 @@ TEST(Instancing, MeshInstanceRendersTheSameBytesAsTheTransformedMesh) {
       "type: mesh, smooth: true, material: red, positions: [[-1, -0.5, -1], [1, -0.5, -1], "
       "[1, -0.5, 1], [-1, -0.5, 1], [0, 1.2, 0], [0, -1.4, 0]], indices: [[0, 1, 4], [1, 2, 4], "
       "[2, 3, 4], [3, 0, 4], [1, 0, 5], [2, 1, 5], [3, 2, 5], [0, 3, 5]]";
-  const Film empty = renderText(kStage + "objects:\n" + kFloor);
-  const Film expected = renderText(writtenOut(mesh));
-  const Film actual = renderText(instanced(mesh));
-  expectSameBytes(actual, expected);
-  EXPECT_GT(litPixels(expected, empty), 500u);
+  expectInstanceRendersAsWrittenOut(mesh);
 }
 
 TEST(Instancing, ManyInstancesEqualTheWrittenOutObjectsOnAnyThreadCount) {
@@ -181,10 +182,7 @@ TEST(Instancing, ATransparentCsgCastsTheSameShadowInAGroup) {
       "type: csg, operation: union, operands: [{type: sphere, center: [-0.5, 0.2, 0], radius: "
       "0.8, material: glass}, {type: box, min: [0.2, -0.4, -0.4], max: [1.2, 0.6, 0.4], "
       "material: red}]";
-  const Film empty = renderText(kStage + "objects:\n" + kFloor);
-  const Film expected = renderText(writtenOut(csg));
-  expectSameBytes(renderText(instanced(csg)), expected);
-  EXPECT_GT(litPixels(expected, empty), 500u);
+  expectInstanceRendersAsWrittenOut(csg);
   // The same union without operand materials, glass given by the instance.
   const std::string open =
       "type: csg, operation: union, operands: [{type: sphere, center: [-0.5, 0.2, 0], radius: "
@@ -192,8 +190,7 @@ TEST(Instancing, ATransparentCsgCastsTheSameShadowInAGroup) {
   const std::string closed =
       "type: csg, operation: union, material: glass, operands: [{type: sphere, center: [-0.5, "
       "0.2, 0], radius: 0.8}, {type: box, min: [0.2, -0.4, -0.4], max: [1.2, 0.6, 0.4]}]";
-  expectSameBytes(renderText(instanced(open, ", material: glass")),
-                  renderText(writtenOut(closed)));
+  expectSameBytes(renderText(instanced(open, ", material: glass")), renderText(writtenOut(closed)));
 }
 
 TEST(Instancing, SolidTexturesFollowTheInstance) {

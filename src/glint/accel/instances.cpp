@@ -126,14 +126,7 @@ Vec3 worldPointError(const PlacedInstance& in, const AffineMatrix& forward, cons
   Vec3 out = worldPointErrorOf(forward.m, in.groupFromWorld.m, p, e, world);
   const auto& a = forward.m;
   const auto& b = in.groupFromWorld.m;
-  double kappa = 0;
-  for (int i = 0; i < 3; ++i) {
-    double row = 0;
-    for (int j = 0; j < 3; ++j)
-      for (int k = 0; k < 3; ++k) row += std::abs(a[i][k]) * std::abs(b[k][j]);
-    kappa = std::max(kappa, row);
-  }
-  const double derivation = gammaBound(24) * kappa;
+  const double derivation = gammaBound(24) * conditionNumberOf(a, b);
   const double pAbs[3] = {std::abs(p.x), std::abs(p.y), std::abs(p.z)};
   for (int i = 0; i < 3; ++i) {
     double linear = 0;

@@ -29,18 +29,25 @@ Vec3 worldPointError(const Transform& worldFromObject, const Point3& p, const Ve
 // spawned near the world point is mapped back by the stored inverse, whose rounding and
 // inexactness as an inverse, carried back to world space, grow with the condition number
 // κ = ‖|M|·|M⁻¹|‖∞ of the linear part: 1 for scales, ≤ 3 for rotations).
+// κ = ‖|M|·|M⁻¹|‖∞ of the linear parts (the 3×3 upper left) of `m` and `inv`, rows as below.
 template <typename Rows>
-Vec3 worldPointErrorOf(const Rows& m, const Rows& inv, const Point3& p, const Vec3& e,
-                       const Point3& world) {
+double conditionNumberOf(const Rows& m, const Rows& inv) {
   double kappa = 0;
-  double translation = 0;
   for (int i = 0; i < 3; ++i) {
     double row = 0;
     for (int j = 0; j < 3; ++j)
       for (int k = 0; k < 3; ++k) row += std::abs(m[i][k]) * std::abs(inv[k][j]);
     kappa = std::max(kappa, row);
-    translation = std::max(translation, std::abs(m[i][3]));
   }
+  return kappa;
+}
+
+template <typename Rows>
+Vec3 worldPointErrorOf(const Rows& m, const Rows& inv, const Point3& p, const Vec3& e,
+                       const Point3& world) {
+  const double kappa = conditionNumberOf(m, inv);
+  double translation = 0;
+  for (int i = 0; i < 3; ++i) translation = std::max(translation, std::abs(m[i][3]));
   const double roundTrip = gammaBound(8) * kappa * (maxComponent(abs(toVec(world))) + translation);
   Vec3 out;
   for (int i = 0; i < 3; ++i) {
