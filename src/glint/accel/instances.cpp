@@ -402,6 +402,20 @@ Color InstanceSet::transmittance(const Ray& ray, double tMin, double tMax) const
   return result;
 }
 
+Transform InstanceSet::placement(std::uint32_t i) const {
+  const AffineMatrix& inverse = instances_[i].groupFromWorld;
+  const AffineMatrix forward = forwardOf(inverse);
+  Matrix4 m = Matrix4::identity();
+  Matrix4 inv = Matrix4::identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      m.m[r][c] = forward.m[r][c];
+      inv.m[r][c] = inverse.m[r][c];
+    }
+  }
+  return Transform(m, inv);
+}
+
 Point3 InstanceSet::groupPoint(std::uint32_t i, const Point3& world) const {
   return applyToPoint(instances_[i].groupFromWorld, world);
 }

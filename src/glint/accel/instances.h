@@ -77,6 +77,9 @@ class InstanceSet {
   std::size_t instanceCount() const { return instances_.size(); }
   const Aggregate& group(std::uint32_t g) const { return *groups_[g]; }
   std::size_t groupCount() const { return groups_.size(); }
+  // Instance i's world-from-group transform: the forward matrix re-derived from the stored inverse
+  // (as for its hit points), with that inverse.
+  Transform placement(std::uint32_t i) const;
   // The group-space point of a world-space point on instance i.
   Point3 groupPoint(std::uint32_t i, const Point3& world) const;
   // A group-space vector (a tangent) in world space.

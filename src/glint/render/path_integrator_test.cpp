@@ -396,6 +396,43 @@ TEST(PathIntegrator, BoxesCylindersConesAndEllipsesAreSampledAsLights) {
   expectEachStrategyAgreesWithMis(parts);
 }
 
+// Emissive objects inside instanced groups are sampled as lights too, each placed by its instance:
+// a sphere and a rectangle in one group placed twice (once under a similarity, where the sphere
+// stays a sphere and is sampled; once under a non-uniform scale, where it is an ellipsoid and is
+// left to BRDF sampling), and a two-triangle emissive mesh in another. The three strategies agree.
+TEST(PathIntegrator, EmittersInsideInstancesAreSampledAsLights) {
+  SceneParts parts = cameraParts(12, 12);
+  parts.camera.position = {0, 2, 6};
+  parts.camera.direction = normalize(Vec3{0, -0.35, -1});
+  parts.image.samples = 1024;
+  parts.primitives.emplace_back(Plane::make({0, 0, 0}, {0, 1, 0}),
+                                addMaterial(parts, diffuse(Color(0.6))), Color{});
+  const std::uint32_t dark = addMaterial(parts, diffuse(Color(0)));
+  GroupParts lamps;
+  lamps.primitives.emplace_back(Sphere::make({0, 0, 0}, 0.25), dark, Color(10, 8, 6));
+  lamps.primitives.emplace_back(Rectangle::make({-0.3, 0.6, -0.3}, {0.6, 0, 0}, {0, 0, 0.6}), dark,
+                                Color(2, 3, 4));
+  GroupParts panel;
+  TriangleMesh mesh;
+  mesh.positions = {{-0.4, 0, -0.4}, {0.4, 0, -0.4}, {0.4, 0, 0.4}, {-0.4, 0, 0.4}};
+  mesh.indices = {0, 2, 1, 0, 3, 2};
+  mesh.materialIndex = dark;
+  mesh.emission = Color(3, 5, 3);
+  panel.meshes.push_back(mesh);
+  parts.groups = {lamps, panel};
+  const Transform similar = Transform::translate({-1.2, 1.2, -0.5}) *
+                            Transform::rotate({1, 1, 0}, 30) * Transform::scale(1.5, 1.5, 1.5);
+  const Transform stretched = Transform::translate({1.3, 1, -1}) * Transform::scale(1, 2, 0.7);
+  const Transform overhead = Transform::translate({0, 3, -0.5}) * Transform::rotate({1, 0, 0}, 20);
+  parts.instances = {makeInstance(&similar, 0), makeInstance(&stretched, 0),
+                     makeInstance(&overhead, 1)};
+  const Scene scene{SceneParts(parts)};
+  ASSERT_NE(scene.emitterSampler(), nullptr);
+  // Sphere + 2 rectangle triangles, 2 rectangle triangles (the ellipsoid left out), 2 triangles.
+  EXPECT_EQ(scene.emitterSampler()->size(), 3u + 2 + 2);
+  expectEachStrategyAgreesWithMis(parts);
+}
+
 // Under `path` an area light is a surface camera rays and mirror rays see, of radiance colour ×
 // intensity; under Whitted it is invisible (the background shows).
 TEST(PathIntegrator, AreaLightsAreSeenByCameraAndMirrorRays) {

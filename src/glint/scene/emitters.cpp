@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <variant>
 
 #include "glint/core/sampling.h"
@@ -43,7 +44,8 @@ void EmitterSampler::add(const Unit& unit, double area) {
 
 std::shared_ptr<const EmitterSampler> EmitterSampler::make(
     const std::vector<Primitive>& primitives, const std::vector<TriangleMesh>& meshes,
-    const std::vector<Material>& materials, const std::vector<MaterialTextures>& textures) {
+    const std::vector<Material>& materials, const std::vector<MaterialTextures>& textures,
+    const InstanceSet* instances, const std::function<std::uint32_t(const Hit&)>& materialOf) {
   std::shared_ptr<EmitterSampler> sampler(new EmitterSampler());
   EmitterSampler& s = *sampler;
   s.cdf_.push_back(0);
@@ -92,11 +94,16 @@ std::shared_ptr<const EmitterSampler> EmitterSampler::make(
     unit.emission = emission;
     s.add(unit, std::numbers::pi * (radius * radius - innerRadius * innerRadius) * stretch);
   };
-  for (std::size_t i = 0; i < primitives.size(); ++i) {
-    const Primitive& primitive = primitives[i];
-    const Color& emission = primitive.emission();
-    if (!(luminance(emission) > 0) || textured(primitive.materialIndex())) continue;
+  // One primitive of emission `emission`, placed in the world by its own transform and then by
+  // `placement` (an instance's; null: none). Whether its whole surface is now sampled.
+  const auto addPrimitive = [&](const Primitive& primitive, const Color& emission,
+                                const Transform* placement) {
+    std::optional<Transform> composed;
     const Transform* transform = primitive.worldFromObject();
+    if (placement != nullptr) {
+      composed = transform ? *placement * *transform : *placement;
+      transform = &*composed;
+    }
     const auto world = [&](const Point3& p) { return transform ? (*transform)(p) : p; };
     const auto worldVector = [&](const Vec3& v) { return transform ? (*transform)(v) : v; };
     // Round shapes stay round only under a similarity: its scale factor, or 0 for another map.
@@ -179,17 +186,82 @@ std::shared_ptr<const EmitterSampler> EmitterSampler::make(
       s.add(side, std::numbers::pi * (cone->baseRadius + cone->apexRadius) * slant * scale * scale);
     }
     // Only a primitive whose whole surface is sampled has the sampler's density at its points.
-    s.sampledPrimitive_[i] = s.units_.size() > before;
+    return s.units_.size() > before;
+  };
+  const auto addMesh = [&](const TriangleMesh& mesh, const Transform* placement) {
+    const std::size_t before = s.units_.size();
+    const auto world = [&](std::uint32_t v) {
+      return placement ? (*placement)(mesh.positions[v]) : mesh.positions[v];
+    };
+    for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
+      addTriangle(world(mesh.indices[3 * t]), world(mesh.indices[3 * t + 1]),
+                  world(mesh.indices[3 * t + 2]), mesh.emission);
+    }
+    return s.units_.size() > before;
+  };
+  for (std::size_t i = 0; i < primitives.size(); ++i) {
+    const Primitive& primitive = primitives[i];
+    if (!(luminance(primitive.emission()) > 0) || textured(primitive.materialIndex())) continue;
+    s.sampledPrimitive_[i] = addPrimitive(primitive, primitive.emission(), nullptr);
   }
   for (std::size_t m = 0; m < meshes.size(); ++m) {
     const TriangleMesh& mesh = meshes[m];
     if (!(luminance(mesh.emission) > 0) || textured(mesh.materialIndex)) continue;
-    const std::size_t before = s.units_.size();
-    for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
-      addTriangle(mesh.positions[mesh.indices[3 * t]], mesh.positions[mesh.indices[3 * t + 1]],
-                  mesh.positions[mesh.indices[3 * t + 2]], mesh.emission);
+    s.sampledMesh_[m] = addMesh(mesh, nullptr);
+  }
+  if (instances != nullptr) {
+    // Emissive objects inside groups, once per instance, placed by the instance's transform and
+    // lit by the instance's material where it gives one. Each instance's emissive objects get
+    // consecutive bits of sampledInstanced_ from instanceBase_[instance] on, in the order of
+    // emissiveSlot_ (the group's primitives, then its meshes). Units past kInstancedUnitBudget
+    // are not added: the instances after that are found only by the paths that hit them.
+    const InstanceSet& set = *instances;
+    s.instances_ = instances;
+    s.emissiveSlot_.resize(set.groupCount());
+    std::vector<std::uint32_t> slotCount(set.groupCount(), 0);
+    bool anyEmissive = false;
+    for (std::uint32_t g = 0; g < set.groupCount(); ++g) {
+      const Aggregate& group = set.group(g);
+      std::vector<std::uint32_t>& slots = s.emissiveSlot_[g];
+      slots.assign(group.primitives().size() + group.meshes().size(), kNotEmissive);
+      for (std::size_t i = 0; i < group.primitives().size(); ++i) {
+        if (luminance(group.primitives()[i].emission()) > 0) slots[i] = slotCount[g]++;
+      }
+      for (std::size_t m = 0; m < group.meshes().size(); ++m) {
+        if (luminance(group.meshes()[m].emission) > 0) {
+          slots[group.primitives().size() + m] = slotCount[g]++;
+        }
+      }
+      anyEmissive = anyEmissive || slotCount[g] > 0;
     }
-    s.sampledMesh_[m] = s.units_.size() > before;
+    if (anyEmissive) {
+      s.instanceBase_.assign(set.instanceCount(), kNotEmissive);
+      const std::size_t budgetEnd = s.units_.size() + kInstancedUnitBudget;
+      for (std::uint32_t i = 0; i < set.instanceCount() && s.units_.size() < budgetEnd; ++i) {
+        const std::uint32_t g = set.instance(i).group;
+        if (slotCount[g] == 0) continue;
+        const Aggregate& group = set.group(g);
+        const Transform placement = set.placement(i);
+        const auto base = static_cast<std::uint32_t>(s.sampledInstanced_.size());
+        s.instanceBase_[i] = base;
+        s.sampledInstanced_.resize(base + slotCount[g], false);
+        Hit hit;
+        hit.instance = i;
+        for (std::size_t k = 0; k < s.emissiveSlot_[g].size(); ++k) {
+          const std::uint32_t slot = s.emissiveSlot_[g][k];
+          if (slot == kNotEmissive) continue;
+          const bool isPrimitive = k < group.primitives().size();
+          hit.primitive = isPrimitive ? static_cast<std::uint32_t>(k) : 0;
+          hit.mesh =
+              isPrimitive ? kNoMesh : static_cast<std::uint32_t>(k - group.primitives().size());
+          if (textured(materialOf(hit))) continue;
+          s.sampledInstanced_[base + slot] =
+              isPrimitive ? addPrimitive(group.primitives()[k], group.primitives()[k].emission(),
+                                         &placement)
+                          : addMesh(group.meshes()[hit.mesh], &placement);
+        }
+      }
+    }
   }
   if (s.units_.empty()) return nullptr;
   for (double& c : s.cdf_) c /= s.totalPower_;
@@ -264,12 +336,18 @@ EmitterSampler::Sample EmitterSampler::sample(const Point2& u) const {
 }
 
 double EmitterSampler::areaPdf(const Hit& hit, const Color& emission) const {
-  // Instanced surfaces are not sampled as lights (only reached by BRDF sampling).
-  const bool sampled =
-      hit.instance == kNoInstance &&
-      (hit.mesh == kNoMesh
-           ? hit.primitive < sampledPrimitive_.size() && sampledPrimitive_[hit.primitive]
-           : hit.mesh < sampledMesh_.size() && sampledMesh_[hit.mesh]);
+  bool sampled = false;
+  if (hit.instance == kNoInstance) {
+    sampled = hit.mesh == kNoMesh
+                  ? hit.primitive < sampledPrimitive_.size() && sampledPrimitive_[hit.primitive]
+                  : hit.mesh < sampledMesh_.size() && sampledMesh_[hit.mesh];
+  } else if (hit.instance < instanceBase_.size() && instanceBase_[hit.instance] != kNotEmissive) {
+    const std::uint32_t g = instances_->instance(hit.instance).group;
+    const std::size_t k =
+        hit.mesh == kNoMesh ? hit.primitive : instances_->group(g).primitives().size() + hit.mesh;
+    const std::uint32_t slot = emissiveSlot_[g][k];
+    sampled = slot != kNotEmissive && sampledInstanced_[instanceBase_[hit.instance] + slot];
+  }
   return sampled ? luminance(emission) / totalPower_ : 0;
 }
 

@@ -5,10 +5,12 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
 #include "glint/accel/aggregate.h"
+#include "glint/accel/instances.h"
 #include "glint/core/color.h"
 #include "glint/core/vec.h"
 #include "glint/geometry/shape.h"
@@ -37,10 +39,22 @@ class EmitterSampler {
   // every triangle of an emissive mesh. Not sampled (found only by the paths that hit them):
   // planes and tubes (infinite), spheres, cylinders and cones under a non-uniform scale or a
   // shear, and emission with a texture. Null when there is nothing to sample.
-  static std::shared_ptr<const EmitterSampler> make(const std::vector<Primitive>& primitives,
-                                                    const std::vector<TriangleMesh>& meshes,
-                                                    const std::vector<Material>& materials,
-                                                    const std::vector<MaterialTextures>& textures);
+  //
+  // With `instances`, the emissive objects of every instance's group are sampled too, each placed
+  // by the instance's transform composed with its own (the same rules for which are sampled), up
+  // to kInstancedUnitBudget sampled units; `materialOf` gives the material index of an instanced
+  // object (Hit with instance, primitive or mesh set: Scene::materialIndexOf), so that emission
+  // textured by an instance's material is left out. The Scene that holds `instances` outlives
+  // the sampler.
+  static std::shared_ptr<const EmitterSampler> make(
+      const std::vector<Primitive>& primitives, const std::vector<TriangleMesh>& meshes,
+      const std::vector<Material>& materials, const std::vector<MaterialTextures>& textures,
+      const InstanceSet* instances = nullptr,
+      const std::function<std::uint32_t(const Hit&)>& materialOf = {});
+  // At most this many sampled units (a triangle, a sphere, a disk, a side) for instanced objects:
+  // ~45 MB of them. A field of instanced lamps past it keeps the first instances' (in the
+  // InstanceSet's order) as lights.
+  static constexpr std::size_t kInstancedUnitBudget = std::size_t{1} << 18;
 
   // A point for u in [0,1)² (u.x picks the emitter and is reused inside it).
   Sample sample(const Point2& u) const;
@@ -78,6 +92,14 @@ class EmitterSampler {
   double totalPower_ = 0;    // Σ luminance × area
   std::vector<bool> sampledPrimitive_;
   std::vector<bool> sampledMesh_;
+  // Instanced emitters (make's `instances`): per group, each object's slot among its emissive
+  // objects (primitives first, then meshes) or kNotEmissive; per instance, the first of its
+  // slots' bits in sampledInstanced_, or kNotEmissive when none of its objects is sampled.
+  static constexpr std::uint32_t kNotEmissive = 0xffffffffu;
+  const InstanceSet* instances_ = nullptr;
+  std::vector<std::vector<std::uint32_t>> emissiveSlot_;
+  std::vector<std::uint32_t> instanceBase_;
+  std::vector<bool> sampledInstanced_;
 };
 
 // Luminance (Rec. 709 weights) of a linear colour.

@@ -348,10 +348,12 @@ Scene::Scene(SceneParts parts)
       render_(parts.render),
       aggregate_(
           buildAggregate(parts, materials_, textures_, materialTextures_, groupTakesMaterial_)),
-      emitterSampler_(render_.integrator == Integrator::Path
-                          ? EmitterSampler::make(aggregate_.primitives(), aggregate_.meshes(),
-                                                 materials_, materialTextures_)
-                          : nullptr) {
+      emitterSampler_(
+          render_.integrator == Integrator::Path
+              ? EmitterSampler::make(aggregate_.primitives(), aggregate_.meshes(), materials_,
+                                     materialTextures_, aggregate_.instances(),
+                                     [this](const Hit& hit) { return materialIndexOf(hit); })
+              : nullptr) {
   initialiseMedia();
   if (render_.integrator != Integrator::Path) return;
   for (const Light& light : lights_) {
