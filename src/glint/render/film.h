@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "glint/core/color.h"
+#include "glint/core/huge_pages.h"
 
 namespace glint {
 
@@ -21,10 +22,11 @@ class Film {
   Film() = default;
   // A film covering `region` of a fullWidth × fullHeight image.
   Film(int fullWidth, int fullHeight, const PixelRegion& region)
-      : fullWidth_(fullWidth),
-        fullHeight_(fullHeight),
-        region_(region),
-        pixels_(static_cast<std::size_t>(region.width()) * region.height()) {}
+      : fullWidth_(fullWidth), fullHeight_(fullHeight), region_(region) {
+    const std::size_t n = static_cast<std::size_t>(region.width()) * region.height();
+    reserveOnHugePages(pixels_, n);  // 24 B a pixel: 19 MB at 1024×768
+    pixels_.resize(n);
+  }
 
   int width() const { return region_.width(); }
   int height() const { return region_.height(); }
