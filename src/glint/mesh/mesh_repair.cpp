@@ -126,6 +126,9 @@ class AssimpVertices {
   }
   bool hasNormals() const { return mesh_.HasNormals(); }
   bool hasTexcoords() const { return mesh_.mTextureCoords[0] != nullptr; }
+  // No shortcut: every vertex is looked up by its key.
+  std::uint32_t knownJoin(unsigned /*v*/) const { return kUnused; }
+  void rememberJoin(unsigned /*v*/, std::uint32_t /*joined*/) const {}
 
  private:
   const aiMesh& mesh_;
@@ -163,8 +166,30 @@ class SimpleObjVertices {
   }
   bool hasNormals() const { return normals_; }
   bool hasTexcoords() const { return texcoords_; }
+  // A corner whose position, normal and texture coordinate indices are those of an earlier joined
+  // corner of the same position index has that corner's key, so its joined vertex: found without
+  // the key's hash lookup (a smooth OBJ surface names each position from about six corners, all
+  // alike). kUnused when not known.
+  std::uint32_t knownJoin(unsigned v) const {
+    if (firstUse_.empty()) firstUse_.assign(obj_.positions.size() / 3, FirstUse{});
+    const FirstUse& first = firstUse_[obj_.vertexIndices[v]];
+    if (first.joined == kUnused || first.normal != normalIndex(v) ||
+        first.texcoord != texcoordIndex(v)) {
+      return kUnused;
+    }
+    return first.joined;
+  }
+  void rememberJoin(unsigned v, std::uint32_t joined) const {
+    FirstUse& first = firstUse_[obj_.vertexIndices[v]];
+    if (first.joined == kUnused) first = {normalIndex(v), texcoordIndex(v), joined};
+  }
 
  private:
+  struct FirstUse {
+    std::uint32_t normal = 0, texcoord = 0, joined = kUnused;
+  };
+  std::uint32_t normalIndex(unsigned v) const { return normals_ ? obj_.normalIndices[v] : 0; }
+  std::uint32_t texcoordIndex(unsigned v) const { return texcoords_ ? obj_.texcoordIndices[v] : 0; }
   static aiVector3D at(const std::vector<float>& values, std::uint32_t i) {
     const std::size_t k = 3 * std::size_t{i};
     return {values[k], values[k + 1], values[k + 2]};
@@ -176,6 +201,7 @@ class SimpleObjVertices {
   mutable unsigned corner_[3] = {0, 0, 0};
   mutable aiVector3D normal_;
   mutable aiVector3D texcoord_;
+  mutable std::vector<FirstUse> firstUse_;  // per position index
 };
 
 std::uint64_t hashOf(const VertexKey& key) {
@@ -368,6 +394,10 @@ JoinedMesh joinVertices(const Vertices& in, std::size_t& dropped) {
     std::uint64_t hashes[3] = {};
     for (int k = 0; k < 3; ++k) {
       if (joinedOf[corners[k]] != kUnused) continue;
+      if (const std::uint32_t known = in.knownJoin(corners[k]); known != kUnused) {
+        joinedOf[corners[k]] = known;
+        continue;
+      }
       cornerKeys[k] =
           keyOf(in.position(corners[k]), in.normal(corners[k]), in.texcoord(corners[k]));
       hashes[k] = hashOf(cornerKeys[k]);
@@ -375,8 +405,8 @@ JoinedMesh joinVertices(const Vertices& in, std::size_t& dropped) {
     }
     for (int k = 0; k < 3; ++k) {
       const unsigned v = corners[k];
-      out.indices.push_back(joinedOf[v] != kUnused ? joinedOf[v]
-                                                   : join(v, cornerKeys[k], hashes[k]));
+      if (joinedOf[v] == kUnused) in.rememberJoin(v, join(v, cornerKeys[k], hashes[k]));
+      out.indices.push_back(joinedOf[v]);
     }
   }
   return out;
