@@ -11,7 +11,9 @@
 // importer (GLINT_OBJ_READER=assimp), alternating the two in every run: reading the bytes, the
 // parse alone, the import (parse, assimp's post-processing, glint's vertex join and repairs), the
 // whole readMeshFile (the sandboxed child started, its answer through the memory file, the
-// parent's checks) and `glint check` of a scene holding the mesh (everything but rendering).
+// parent's checks) and `glint check` of a scene holding the mesh (everything but rendering). The
+// phases before readMeshFile each run in a fresh process started as the mesh reader is (its
+// environment and malloc settings).
 //
 //   scene_loading [--spheres N] [--obj T] [--runs R] [--dir DIR] [--quick]
 #include <malloc.h>
@@ -109,32 +111,58 @@ double median(std::vector<double> v) {
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
-// Seconds `work` takes (or the seconds it returns; negative: it failed) in a forked child that
-// starts as the mesh reader program does (a fresh heap, large blocks from the heap:
-// import_child.cpp), so that no run inherits the heap another left behind; negative when `work`
-// fails.
-template <class Work>
-double secondsInChild(Work&& work) {
+// One phase of loading `obj` in this process (the --phase mode), its seconds; negative when it
+// fails. "read": the file into memory; "parse": assimp's ReadFile, or the bytes read (untimed) and
+// parseSimpleObj; "import": importMeshWithAssimp or importSimpleObj.
+double runPhase(const std::string& phase, bool useAssimp, const fs::path& obj) {
+  const auto readText = [&] {
+    std::ifstream in(obj, std::ios::binary);
+    std::string text(static_cast<std::size_t>(fs::file_size(obj)), '\0');
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    return in ? text : std::string();
+  };
+  const glint::ReferencedFileRule rule(obj, obj.parent_path());
+  glint::bench::Stopwatch watch;
+  if (phase == "read") return readText().empty() ? -1 : watch.seconds();
+  if (phase == "parse" && useAssimp) {
+    Assimp::Importer importer;  // reads the file itself
+    return importer.ReadFile(obj.string(), 0) != nullptr ? watch.seconds() : -1;
+  }
+  if (phase == "parse") {
+    const std::string text = readText();
+    glint::bench::Stopwatch parse;
+    return glint::parseSimpleObj(text) ? parse.seconds() : -1;
+  }
+  if (phase == "import" && useAssimp) {
+    return glint::importMeshWithAssimp(obj, ".obj", rule).parts.empty() ? -1 : watch.seconds();
+  }
+  if (phase == "import") return glint::importSimpleObj(obj, rule) ? watch.seconds() : -1;
+  return -1;
+}
+
+// runPhase in a fresh program (this one, started again with --phase) that begins as the mesh
+// reader does: a new process (no heap inherited from a fork), the reader's environment (glibc's
+// malloc on huge pages: import_child.cpp, meshReaderEnvironment) and malloc settings.
+double phaseInProgram(const std::string& phase, bool useAssimp, const fs::path& obj) {
   int fds[2];
   if (::pipe(fds) != 0) return -1;
   std::fflush(stdout);
   const pid_t pid = ::fork();
   if (pid == 0) {
+    ::dup2(fds[1], 1);
     ::close(fds[0]);
-    ::mallopt(M_MMAP_THRESHOLD, 32 << 20);
-    glint::bench::Stopwatch watch;
-    double seconds = work();  // a phase's own time, or 0: the whole work's
-    if (seconds == 0) seconds = watch.seconds();
-    const ssize_t written = ::write(fds[1], &seconds, sizeof seconds);
-    ::_exit(written == sizeof seconds ? 0 : 1);
+    ::setenv("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1", 1);
+    ::execl("/proc/self/exe", "scene_loading", "--phase", phase.c_str(),
+            useAssimp ? "assimp" : "glint", obj.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
   }
   ::close(fds[1]);
-  double seconds = -1;
-  if (::read(fds[0], &seconds, sizeof seconds) != sizeof seconds) seconds = -1;
+  char answer[64] = {};
+  const ssize_t n = ::read(fds[0], answer, sizeof answer - 1);
   ::close(fds[0]);
   int status = 0;
   ::waitpid(pid, &status, 0);
-  return seconds;
+  return n > 0 ? std::atof(answer) : -1;
 }
 
 // The same mesh (positions, normals, uvs, indices, materials) in both, to the bit.
@@ -210,28 +238,9 @@ int objLoading(int triangles, const fs::path& dir, const glint::bench::CommonOpt
       } else {
         ::unsetenv("GLINT_OBJ_READER");
       }
-      const auto readText = [&] {
-        std::ifstream in(obj, std::ios::binary);
-        std::string text(static_cast<std::size_t>(fs::file_size(obj)), '\0');
-        in.read(text.data(), static_cast<std::streamsize>(text.size()));
-        return in ? text : std::string();
-      };
-      const double read = secondsInChild([&] { return readText().empty() ? -1.0 : 0.0; });
-      // The parse alone, of the bytes read before.
-      const double parse = secondsInChild([&] {
-        if (useAssimp) {
-          Assimp::Importer importer;  // reads the file itself
-          return importer.ReadFile(obj.string(), 0) != nullptr ? 0.0 : -1.0;
-        }
-        const std::string text = readText();
-        glint::bench::Stopwatch watch;
-        return glint::parseSimpleObj(text) ? watch.seconds() : -1.0;
-      });
-      const double import = secondsInChild([&] {
-        if (useAssimp)
-          return glint::importMeshWithAssimp(obj, ".obj", rule).parts.empty() ? -1.0 : 0.0;
-        return glint::importSimpleObj(obj, rule) ? 0.0 : -1.0;
-      });
+      const double read = phaseInProgram("read", useAssimp, obj);
+      const double parse = phaseInProgram("parse", useAssimp, obj);
+      const double import = phaseInProgram("import", useAssimp, obj);
       if (read < 0 || parse < 0 || import < 0) {
         fmt::print(stderr, "{} failed to read the torus\n",
                    useAssimp ? "assimp" : "glint's parser");
@@ -278,6 +287,11 @@ int objLoading(int triangles, const fs::path& dir, const glint::bench::CommonOpt
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 5 && std::strcmp(argv[1], "--phase") == 0) {  // phaseInProgram's child
+    ::mallopt(M_MMAP_THRESHOLD, 32 << 20);                  // as the mesh reader (import_child.cpp)
+    std::printf("%.9f\n", runPhase(argv[2], std::strcmp(argv[3], "assimp") == 0, argv[4]));
+    return 0;
+  }
   std::vector<glint::bench::ExtraOption> extra = {{"--spheres"}, {"--dir"}, {"--obj"}};
   const glint::bench::CommonOptions options = glint::bench::parseCommonOptions(
       argc, argv,
@@ -285,7 +299,9 @@ int main(int argc, char** argv) {
   std::size_t count = options.quick ? 20000 : 100000;
   if (extra[0].present) count = std::stoul(extra[0].value);
   const fs::path dir = extra[1].present ? fs::path(extra[1].value) : fs::temp_directory_path();
-  if (extra[2].present) return objLoading(std::stoi(extra[2].value), dir, options);
+  if (extra[2].present) {
+    return objLoading(std::stoi(extra[2].value), dir, options);
+  }
   const int runs = options.runs;
   const std::vector<Sphere> list = spheres(count);
   const fs::path scene = dir / fmt::format("glint-bench-spheres-{}.yaml", count);
