@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -80,6 +81,11 @@ struct SphereSpec {
 // are stored too (as a smooth mesh loaded from a file would have them).
 TriangleMesh makeTorus(const Point3& center, double majorRadius, double minorRadius,
                        int majorSegments, int minorSegments, bool normals);
+
+// `mesh` as an OBJ file: a comment line, `v` and `vn` lines (%.9g: a double's value to float
+// precision and beyond), one `f a//a b//b c//c` line per triangle — what the renderer comparison
+// and the loading benchmark hand to glint.
+void writeObj(const std::filesystem::path& path, const TriangleMesh& mesh);
 
 // Two triangles covering the square [−halfSize, halfSize]² around (centre.x, centre.z) at height
 // centre.y, normal +y.

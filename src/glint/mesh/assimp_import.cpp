@@ -1,12 +1,19 @@
 #include "glint/mesh/assimp_import.h"
 
+#include <sys/mman.h>
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <new>
+#include <optional>
 #include <set>
+#include <stdexcept>
+#include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -20,10 +27,12 @@
 #include <assimp/scene.h>
 #include <assimp/texture.h>
 #include <fmt/format.h>
+#include <assimp/IOStream.hpp>
 #include <assimp/Importer.hpp>
 
 #include "glint/core/file_access.h"
 #include "glint/mesh/mesh_repair.h"
+#include "glint/mesh/obj_fast_parse.h"
 #include "glint/scene/scene_limits.h"
 
 namespace glint {
@@ -56,15 +65,22 @@ class MeshFileAccess : public Assimp::DefaultIOSystem {
         std::string_view(mode).find_first_of("wa+") != std::string_view::npos) {
       return nullptr;
     }
-    if (refused(rule_.refusal(file))) return nullptr;
-    ReadableFile opened = openForReading(file);
-    if (!accepted(file, opened) || refused(rule_.openedRefusal(opened.fd, file))) {
-      return nullptr;
-    }
+    ReadableFile opened = openChecked(file);
+    if (opened.fd < 0) return nullptr;
     FILE* stream = ::fdopen(opened.fd, "rb");
     if (stream == nullptr) return nullptr;
     opened.release();  // the stream closes it
     return new OpenedFileStream(stream, file);
+  }
+  // The file opened for reading when the rules allow it (else fd −1, the refusal kept).
+  ReadableFile openChecked(const char* file) {
+    ReadableFile opened;
+    if (refused(rule_.refusal(file))) return opened;
+    opened = openForReading(file);
+    if (!accepted(file, opened) || refused(rule_.openedRefusal(opened.fd, file))) {
+      return ReadableFile();
+    }
+    return opened;
   }
   // DefaultIOSystem::Exists opens the file with fopen, which blocks on a FIFO.
   bool Exists(const char* file) const override {
@@ -212,14 +228,108 @@ MeshMaterial convertMaterial(const aiMaterial& m) {
   return out;
 }
 
-}  // namespace
+// An OBJ file of the simple subset (obj_fast_parse.h), already parsed, as an importer of
+// assimp's: it builds the scene assimp's OBJ importer builds for such a file — a root node named
+// after the file, one child node and one mesh named after the object, one vertex per face corner
+// in face order, polygons left for Triangulate, the one material "DefaultMaterial" — so that the
+// same post-processing and glint's repairs then run on the same data.
+class SimpleObjImporter : public Assimp::BaseImporter {
+ public:
+  explicit SimpleObjImporter(const SimpleObj& obj) : obj_(obj) {}
+  bool CanRead(const std::string& /*file*/, Assimp::IOSystem* /*io*/,
+               bool /*checkSig*/) const override {
+    return true;
+  }
+  const aiImporterDesc* GetInfo() const override {
+    static const aiImporterDesc info = {"glint simple OBJ",
+                                        "",
+                                        "",
+                                        "the plain subset of OBJ; the rest goes to assimp's",
+                                        0,
+                                        0,
+                                        0,
+                                        0,
+                                        0,
+                                        "obj"};
+    return &info;
+  }
 
-MeshFile importMesh(const std::filesystem::path& path, const std::string& extension,
-                    const ReferencedFileRule& rule) {
+ protected:
+  void InternReadFile(const std::string& file, aiScene* scene, Assimp::IOSystem* /*io*/) override {
+    const std::size_t slash = file.find_last_of("\\/");
+    buildScene(obj_, slash == std::string::npos ? file : file.substr(slash + 1), *scene);
+  }
+
+ private:
+  static void buildScene(const SimpleObj& obj, const std::string& modelName, aiScene& scene) {
+    scene.mRootNode = new aiNode(modelName);
+    auto* child = new aiNode(obj.objectName);
+    child->mParent = scene.mRootNode;
+    scene.mRootNode->mNumChildren = 1;
+    scene.mRootNode->mChildren = new aiNode* [1] { child };
+    child->mNumMeshes = 1;
+    child->mMeshes = new unsigned[1]{0};
+    auto* mesh = new aiMesh;
+    scene.mNumMeshes = 1;
+    scene.mMeshes = new aiMesh* [1] { mesh };
+    auto* material = new aiMaterial;
+    const aiString name(AI_DEFAULT_MATERIAL_NAME);
+    material->AddProperty(&name, AI_MATKEY_NAME);
+    scene.mNumMaterials = 1;
+    scene.mMaterials = new aiMaterial* [1] { material };
+
+    mesh->mName.Set(obj.objectName);
+    mesh->mMaterialIndex = 0;
+    const auto corners = static_cast<unsigned>(obj.vertexIndices.size());
+    mesh->mNumFaces = static_cast<unsigned>(obj.faceSizes.size());
+    mesh->mFaces = new aiFace[mesh->mNumFaces];
+    mesh->mNumVertices = corners;
+    mesh->mVertices = new aiVector3D[corners];
+    const bool normals = !obj.normalIndices.empty();
+    const bool uvs = !obj.texcoordIndices.empty();
+    if (normals) mesh->mNormals = new aiVector3D[corners];
+    if (uvs) {
+      mesh->mNumUVComponents[0] = obj.texcoordDimension;
+      mesh->mTextureCoords[0] = new aiVector3D[corners];
+    }
+    const auto vector3 = [](const std::vector<float>& values, std::uint32_t i) {
+      return aiVector3D(values[3 * std::size_t{i}], values[3 * std::size_t{i} + 1],
+                        values[3 * std::size_t{i} + 2]);
+    };
+    unsigned corner = 0;
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      aiFace& face = mesh->mFaces[f];
+      face.mNumIndices = obj.faceSizes[f];
+      face.mIndices = new unsigned[face.mNumIndices];
+      mesh->mPrimitiveTypes |=
+          face.mNumIndices > 3 ? aiPrimitiveType_POLYGON : aiPrimitiveType_TRIANGLE;
+      for (unsigned k = 0; k < face.mNumIndices; ++k, ++corner) {
+        face.mIndices[k] = corner;
+        mesh->mVertices[corner] = vector3(obj.positions, obj.vertexIndices[corner]);
+        if (normals) mesh->mNormals[corner] = vector3(obj.normals, obj.normalIndices[corner]);
+        if (uvs) {
+          mesh->mTextureCoords[0][corner] = vector3(obj.texcoords, obj.texcoordIndices[corner]);
+        }
+      }
+    }
+  }
+
+  const SimpleObj& obj_;  // outlives the importer (importScene's caller holds it)
+};
+
+// importMesh with assimp's importer for `extension`, or with SimpleObjImporter alone for
+// `simpleObj` when given.
+MeshFile importScene(const std::filesystem::path& path, const std::string& extension,
+                     const ReferencedFileRule& rule, const SimpleObj* simpleObj) {
   Assimp::Importer importer;
   auto* files = new MeshFileAccess(rule);
   importer.SetIOHandler(files);  // the importer owns it
-  keepOnlyImporterFor(importer, extension);
+  if (simpleObj != nullptr) {
+    keepOnlyImporterFor(importer, ".");                          // none
+    importer.RegisterLoader(new SimpleObjImporter(*simpleObj));  // the importer owns it
+  } else {
+    keepOnlyImporterFor(importer, extension);
+  }
   // Points and lines are not surfaces: SortByPType removes them after triangulation.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
@@ -321,6 +431,83 @@ MeshFile importMesh(const std::filesystem::path& path, const std::string& extens
     throw MeshLoadError(assimpReason(e.what()));
   }
   return result;
+}
+
+}  // namespace
+
+std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
+                                        const ReferencedFileRule& rule) {
+  try {
+    // The bytes, opened as assimp's importers open the file (MeshFileAccess) and mapped rather
+    // than copied: reading them into fresh memory costs a page fault per 4 KiB, mapping them
+    // with MAP_POPULATE one call. (A file cut short while mapped kills this child with SIGBUS:
+    // a refused file, as any crash here.)
+    std::optional<SimpleObj> obj;
+    {
+      MeshFileAccess files(rule);
+      const ReadableFile file = files.openChecked(path.c_str());
+      struct stat status {};
+      if (file.fd < 0 || ::fstat(file.fd, &status) != 0 || status.st_size <= 0) {
+        return std::nullopt;
+      }
+      const auto size = static_cast<std::size_t>(status.st_size);
+      void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd, 0);
+      if (mapped == MAP_FAILED) return std::nullopt;
+      try {
+        obj = parseSimpleObj(std::string_view(static_cast<const char*>(mapped), size));
+      } catch (...) {
+        ::munmap(mapped, size);
+        throw;
+      }
+      ::munmap(mapped, size);
+    }
+    if (!obj) return std::nullopt;
+    const bool triangles = std::all_of(obj->faceSizes.begin(), obj->faceSizes.end(),
+                                       [](std::uint32_t corners) { return corners == 3; });
+    if (!triangles || obj->normalIndices.empty()) {
+      // Polygons to triangulate or normals to generate: assimp's steps on the scene its OBJ
+      // importer would have made.
+      return importScene(path, ".obj", rule, &*obj);
+    }
+    // Nothing for assimp's steps to change: importScene's conversion straight from the arrays.
+    MeshFile result;
+    const std::uint64_t triangleCount = obj->faceSizes.size();
+    if (triangleCount > kMaxMeshTriangles) return std::nullopt;  // assimp's words for it
+    TriangleMesh part = joinSimpleObj(*obj, result.droppedTriangles);
+    obj.reset();
+    const double bytesNeeded = 12.0 * static_cast<double>(triangleCount) +
+                               48.0 * static_cast<double>(part.positions.size());
+    const std::uint64_t physical = physicalMemoryBytes();
+    if (part.indices.empty() ||
+        (physical != 0 && bytesNeeded > static_cast<double>(physical) / 2)) {
+      return std::nullopt;
+    }
+    MeshMaterial material;
+    material.name = AI_DEFAULT_MATERIAL_NAME;
+    material.material = kMeshDefaultMaterial;
+    material.fromFile = false;
+    result.materials.push_back(std::move(material));
+    part.materialIndex = 0;
+    result.parts.push_back(std::move(part));
+    return result;
+  } catch (const MeshLoadError&) {
+    // An error: assimp's importer says it in its own words.
+  } catch (const std::bad_alloc&) {
+  }
+  return std::nullopt;
+}
+
+MeshFile importMeshWithAssimp(const std::filesystem::path& path, const std::string& extension,
+                              const ReferencedFileRule& rule) {
+  return importScene(path, extension, rule, nullptr);
+}
+
+MeshFile importMesh(const std::filesystem::path& path, const std::string& extension,
+                    const ReferencedFileRule& rule) {
+  if (extension == ".obj" && !objFastPathDisabled()) {
+    if (std::optional<MeshFile> file = importSimpleObj(path, rule)) return std::move(*file);
+  }
+  return importMeshWithAssimp(path, extension, rule);
 }
 
 }  // namespace glint

@@ -140,8 +140,9 @@ struct MeshReadOptions {
 // PLY header must end (end_header) within 64 KiB; a glTF strip or fan primitive needs its vertices.
 // assimp runs in a child process (fork) that sends the result back through a pipe: fuzzing found
 // memory corruption inside assimp 5.2's importers, which there becomes a refused file ("the mesh
-// library crashed reading it") instead of a crashed or corrupted renderer. Throws Cancelled when
-// options.cancel is set.
+// library crashed reading it") instead of a crashed or corrupted renderer. Plain OBJ files are
+// parsed in that child by glint's own parser (obj_fast_parse.h), with the same result to the bit.
+// Throws Cancelled when options.cancel is set.
 MeshFile readMeshFile(const std::filesystem::path& path, const MeshReadOptions& options = {});
 
 // The world-space meshes of one mesh object: every part of `file` with `worldFromFile` applied —

@@ -9,6 +9,7 @@
 #include <assimp/scene.h>
 
 #include "glint/mesh/mesh_file.h"
+#include "glint/mesh/obj_fast_parse.h"
 
 namespace glint {
 
@@ -84,28 +85,124 @@ struct VertexKey {
   }
 };
 
-VertexKey keyOf(const aiMesh& mesh, unsigned v) {
+// `normal` and `texcoord` may be null (the mesh has none).
+VertexKey keyOf(const aiVector3D& p, const aiVector3D* normal, const aiVector3D* texcoord) {
   VertexKey key{};
-  const aiVector3D& p = mesh.mVertices[v];
   key.p[0] = p.x + 0.0f;
   key.p[1] = p.y + 0.0f;
   key.p[2] = p.z + 0.0f;
-  if (mesh.mNormals != nullptr) {
-    const aiVector3D& n = mesh.mNormals[v];
+  if (normal != nullptr) {
+    const aiVector3D& n = *normal;
     if (std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z)) {
       key.n[0] = n.x + 0.0f;
       key.n[1] = n.y + 0.0f;
       key.n[2] = n.z + 0.0f;
     }
   }
-  if (mesh.mTextureCoords[0] != nullptr) {
-    const aiVector3D& t = mesh.mTextureCoords[0][v];
+  if (texcoord != nullptr) {
+    const aiVector3D& t = *texcoord;
     // NaN ≠ NaN would never join: such coordinates become 0 (the texture lookup tames them anyway).
     key.t[0] = std::isfinite(t.x) ? t.x + 0.0f : 0.0f;
     key.t[1] = std::isfinite(t.y) ? t.y + 0.0f : 0.0f;
   }
   return key;
 }
+
+// The vertices of an assimp mesh, for joinVertices and convertVertices.
+class AssimpVertices {
+ public:
+  explicit AssimpVertices(const aiMesh& mesh) : mesh_(mesh) {}
+  unsigned faceCount() const { return mesh_.mNumFaces; }
+  unsigned faceSize(unsigned f) const { return mesh_.mFaces[f].mNumIndices; }
+  // The vertex at corner k of face f (3 corners).
+  const unsigned* face(unsigned f) const { return mesh_.mFaces[f].mIndices; }
+  unsigned vertexCount() const { return mesh_.mNumVertices; }
+  const aiVector3D& position(unsigned v) const { return mesh_.mVertices[v]; }
+  const aiVector3D* normal(unsigned v) const {
+    return mesh_.mNormals != nullptr ? &mesh_.mNormals[v] : nullptr;
+  }
+  const aiVector3D* texcoord(unsigned v) const {
+    return mesh_.mTextureCoords[0] != nullptr ? &mesh_.mTextureCoords[0][v] : nullptr;
+  }
+  bool hasNormals() const { return mesh_.HasNormals(); }
+  bool hasTexcoords() const { return mesh_.mTextureCoords[0] != nullptr; }
+  // No shortcut: every vertex is looked up by its key.
+  std::uint32_t knownJoin(unsigned /*v*/) const { return kUnused; }
+  void rememberJoin(unsigned /*v*/, std::uint32_t /*joined*/) const {}
+
+ private:
+  const aiMesh& mesh_;
+};
+
+// The one mesh assimp's OBJ importer makes of a SimpleObj of triangles — a vertex per face corner,
+// numbered in face order, with the corner's position, normal and texture coordinates — read from
+// the OBJ's own arrays instead of copied out.
+class SimpleObjVertices {
+ public:
+  explicit SimpleObjVertices(const SimpleObj& obj)
+      : obj_(obj),
+        corners_(static_cast<unsigned>(obj.vertexIndices.size())),
+        normals_(!obj.normalIndices.empty()),
+        texcoords_(!obj.texcoordIndices.empty()) {}
+  unsigned faceCount() const { return static_cast<unsigned>(obj_.faceSizes.size()); }
+  unsigned faceSize(unsigned /*f*/) const { return 3; }
+  const unsigned* face(unsigned f) const {
+    corner_[0] = 3 * f;
+    corner_[1] = 3 * f + 1;
+    corner_[2] = 3 * f + 2;
+    return corner_;
+  }
+  unsigned vertexCount() const { return corners_; }
+  aiVector3D position(unsigned v) const { return at(obj_.positions, obj_.vertexIndices[v]); }
+  const aiVector3D* normal(unsigned v) const {
+    if (!normals_) return nullptr;
+    normal_ = at(obj_.normals, obj_.normalIndices[v]);
+    return &normal_;
+  }
+  const aiVector3D* texcoord(unsigned v) const {
+    if (!texcoords_) return nullptr;
+    texcoord_ = at(obj_.texcoords, obj_.texcoordIndices[v]);
+    return &texcoord_;
+  }
+  bool hasNormals() const { return normals_; }
+  bool hasTexcoords() const { return texcoords_; }
+  // A corner whose position, normal and texture coordinate indices are those of an earlier joined
+  // corner of the same position index has that corner's key, so its joined vertex: found without
+  // the key's hash lookup (a smooth OBJ surface names each position from about six corners, all
+  // alike). kUnused when not known.
+  std::uint32_t knownJoin(unsigned v) const {
+    if (firstUse_.empty()) firstUse_.assign(obj_.positions.size() / 3, FirstUse{});
+    const FirstUse& first = firstUse_[obj_.vertexIndices[v]];
+    if (first.joined == kUnused || first.normal != normalIndex(v) ||
+        first.texcoord != texcoordIndex(v)) {
+      return kUnused;
+    }
+    return first.joined;
+  }
+  void rememberJoin(unsigned v, std::uint32_t joined) const {
+    FirstUse& first = firstUse_[obj_.vertexIndices[v]];
+    if (first.joined == kUnused) first = {normalIndex(v), texcoordIndex(v), joined};
+  }
+
+ private:
+  struct FirstUse {
+    std::uint32_t normal = 0, texcoord = 0, joined = kUnused;
+  };
+  std::uint32_t normalIndex(unsigned v) const { return normals_ ? obj_.normalIndices[v] : 0; }
+  std::uint32_t texcoordIndex(unsigned v) const { return texcoords_ ? obj_.texcoordIndices[v] : 0; }
+  static aiVector3D at(const std::vector<float>& values, std::uint32_t i) {
+    const std::size_t k = 3 * std::size_t{i};
+    return {values[k], values[k + 1], values[k + 2]};
+  }
+  const SimpleObj& obj_;
+  unsigned corners_;
+  bool normals_;
+  bool texcoords_;
+  mutable unsigned corner_[3] = {0, 0, 0};
+  mutable aiVector3D normal_;
+  mutable aiVector3D texcoord_;
+  mutable std::vector<FirstUse> firstUse_;  // per position index
+};
 
 std::uint64_t hashOf(const VertexKey& key) {
   // FNV-1a over the eight floats' bits (positions are finite here: triangles touching a
@@ -217,18 +314,22 @@ std::size_t facesWithTriangles(const aiScene& scene) {
   return n;
 }
 
-JoinedMesh joinMesh(const aiMesh& in, std::size_t& dropped) {
+namespace {
+
+// joinMesh over either kind of vertices.
+template <class Vertices>
+JoinedMesh joinVertices(const Vertices& in, std::size_t& dropped) {
   JoinedMesh out;
-  out.indices.reserve(std::size_t{3} * in.mNumFaces);
+  out.indices.reserve(std::size_t{3} * in.faceCount());
   std::vector<VertexKey> keys;  // of the joined vertices, in step with out.source
-  std::vector<std::uint32_t> joinedOf(in.mNumVertices, kUnused);  // assimp vertex → joined
+  std::vector<std::uint32_t> joinedOf(in.vertexCount(), kUnused);  // assimp vertex → joined
   // Open addressing, linear probing, at most half full; sized for the joined vertices (a smooth
   // OBJ surface has about one per six face corners) and doubled as they grow, so that the table
   // stays small enough for the cache. A slot holds the joined vertex in its low 32 bits and the
   // hash's high 32 bits above, which rule out almost every other key without reading it.
   constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
   std::size_t slots = 16;
-  while (slots < std::size_t{in.mNumVertices} / 3) slots *= 2;
+  while (slots < std::size_t{in.vertexCount()} / 3) slots *= 2;
   std::vector<std::uint64_t> table(slots, kEmpty);
   const auto place = [&](std::uint64_t hash, std::uint32_t j) {
     std::size_t slot = hash & (slots - 1);
@@ -256,21 +357,22 @@ JoinedMesh joinMesh(const aiMesh& in, std::size_t& dropped) {
     }
     return joinedOf[v] = j;
   };
-  for (unsigned f = 0; f < in.mNumFaces; ++f) {
-    const aiFace& face = in.mFaces[f];
-    if (face.mNumIndices != 3) {
-      if (face.mNumIndices > 3 || face.mNumIndices == 0) dropped += trianglesOf(face);
+  for (unsigned f = 0; f < in.faceCount(); ++f) {
+    const unsigned size = in.faceSize(f);
+    if (size != 3) {
+      if (size > 3 || size == 0) dropped += size >= 3 ? size - 2 : 1;
       continue;
     }
-    const unsigned a = face.mIndices[0];
-    const unsigned b = face.mIndices[1];
-    const unsigned c = face.mIndices[2];
-    if (a >= in.mNumVertices || b >= in.mNumVertices || c >= in.mNumVertices) {
+    const unsigned* face = in.face(f);
+    const unsigned a = face[0];
+    const unsigned b = face[1];
+    const unsigned c = face[2];
+    if (a >= in.vertexCount() || b >= in.vertexCount() || c >= in.vertexCount()) {
       ++dropped;
       continue;
     }
     const auto point = [&](unsigned v) {
-      const aiVector3D& p = in.mVertices[v];
+      const aiVector3D p = in.position(v);
       return Point3{p.x, p.y, p.z};
     };
     const Point3 p0 = point(a);
@@ -292,43 +394,65 @@ JoinedMesh joinMesh(const aiMesh& in, std::size_t& dropped) {
     std::uint64_t hashes[3] = {};
     for (int k = 0; k < 3; ++k) {
       if (joinedOf[corners[k]] != kUnused) continue;
-      cornerKeys[k] = keyOf(in, corners[k]);
+      if (const std::uint32_t known = in.knownJoin(corners[k]); known != kUnused) {
+        joinedOf[corners[k]] = known;
+        continue;
+      }
+      cornerKeys[k] =
+          keyOf(in.position(corners[k]), in.normal(corners[k]), in.texcoord(corners[k]));
       hashes[k] = hashOf(cornerKeys[k]);
       __builtin_prefetch(&table[hashes[k] & (slots - 1)]);
     }
     for (int k = 0; k < 3; ++k) {
       const unsigned v = corners[k];
-      out.indices.push_back(joinedOf[v] != kUnused ? joinedOf[v]
-                                                   : join(v, cornerKeys[k], hashes[k]));
+      if (joinedOf[v] == kUnused) in.rememberJoin(v, join(v, cornerKeys[k], hashes[k]));
+      out.indices.push_back(joinedOf[v]);
     }
   }
   return out;
 }
 
-TriangleMesh convertMesh(const aiMesh& in, JoinedMesh&& joined) {
+// convertMesh over either kind of vertices.
+template <class Vertices>
+TriangleMesh convertVertices(const Vertices& in, JoinedMesh&& joined) {
   TriangleMesh out;
   out.indices = std::move(joined.indices);
   out.positions.resize(joined.source.size());
   for (std::size_t j = 0; j < joined.source.size(); ++j) {
-    const aiVector3D& p = in.mVertices[joined.source[j]];
+    const aiVector3D p = in.position(joined.source[j]);
     out.positions[j] = {p.x, p.y, p.z};
   }
-  if (in.HasNormals()) {
+  if (in.hasNormals()) {
     out.normals.resize(joined.source.size());
     for (std::size_t j = 0; j < joined.source.size(); ++j) {
-      const aiVector3D& n = in.mNormals[joined.source[j]];
+      const aiVector3D n = *in.normal(joined.source[j]);
       out.normals[j] = {n.x, n.y, n.z};
     }
   }
-  if (in.mTextureCoords[0] != nullptr) {
+  if (in.hasTexcoords()) {
     out.uvs.resize(joined.source.size());
     for (std::size_t j = 0; j < joined.source.size(); ++j) {
-      const aiVector3D& t = in.mTextureCoords[0][joined.source[j]];
+      const aiVector3D t = *in.texcoord(joined.source[j]);
       out.uvs[j] = {std::isfinite(t.x) ? t.x : 0.0, std::isfinite(t.y) ? t.y : 0.0};
     }
   }
   repairNormals(out);
   return out;
+}
+
+}  // namespace
+
+JoinedMesh joinMesh(const aiMesh& in, std::size_t& dropped) {
+  return joinVertices(AssimpVertices(in), dropped);
+}
+
+TriangleMesh convertMesh(const aiMesh& in, JoinedMesh&& joined) {
+  return convertVertices(AssimpVertices(in), std::move(joined));
+}
+
+TriangleMesh joinSimpleObj(const SimpleObj& obj, std::size_t& dropped) {
+  const SimpleObjVertices vertices(obj);
+  return convertVertices(vertices, joinVertices(vertices, dropped));
 }
 
 }  // namespace glint

@@ -15,6 +15,8 @@ struct aiScene;
 
 namespace glint {
 
+struct SimpleObj;
+
 // Removes, in place, every face that has no index or one past the mesh's vertices, before
 // assimp's post-processing steps (which index vertex arrays without checking) see it. Most
 // importers check their indices (OBJ refuses the file); PLY, for one, does not. Returns the
@@ -55,5 +57,13 @@ JoinedMesh joinMesh(const aiMesh& in, std::size_t& dropped);
 // space, with the first set of texture coordinates as its uvs. Invalid vertex normals (zero or not
 // finite) are rebuilt from the triangles around the vertex.
 TriangleMesh convertMesh(const aiMesh& in, JoinedMesh&& joined);
+
+// convertMesh(joinMesh(m)) for the mesh m that assimp's OBJ importer, its post-processing and
+// glint's repairs above make of an OBJ file of the simple subset (obj_fast_parse.h) whose faces
+// are all triangles and whose corners all name a normal — where those steps change nothing (no
+// polygon to triangulate, no normal to generate, no invalid index, no node transform) — read
+// straight from the file's arrays instead of from a vertex per face corner: the same TriangleMesh.
+// Adds the triangles left out to `dropped`.
+TriangleMesh joinSimpleObj(const SimpleObj& obj, std::size_t& dropped);
 
 }  // namespace glint
