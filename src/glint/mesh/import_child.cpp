@@ -32,6 +32,7 @@
 
 #include "glint/core/cancel.h"
 #include "glint/core/file_access.h"
+#include "glint/core/huge_pages.h"
 #include "glint/mesh/assimp_import.h"
 
 namespace glint {
@@ -170,7 +171,11 @@ class Reader {
   template <typename T>
   void vector(std::vector<T>& out, std::uint64_t limit) {
     const auto n = static_cast<std::size_t>(count(limit));
-    adviseHugePages(out, n);
+    // Reserved on huge pages before anything touches it: filling tens of megabytes a 4 KiB page
+    // fault at a time cost more than the child's whole import of a 1M-triangle OBJ here (the
+    // reader itself runs with glibc.malloc.hugetlb, meshReaderEnvironment; this process's malloc
+    // is the user's).
+    reserveOnHugePages(out, n);
     out.resize(n);
     bytes(out.data(), out.size() * sizeof(T));
   }
@@ -181,23 +186,6 @@ class Reader {
   }
 
  private:
-  // A large array of the answer is reserved first and its memory marked for transparent huge
-  // pages before anything touches it: filling tens of megabytes a 4 KiB page fault at a time cost
-  // more than the child's whole import of a 1M-triangle OBJ here (the reader itself runs with
-  // glibc.malloc.hugetlb, meshReaderEnvironment; this process's malloc is the user's). Only a
-  // hint: where the system gives no huge pages nothing changes.
-  template <typename T>
-  static void adviseHugePages(std::vector<T>& out, std::size_t n) {
-    constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-    if (n * sizeof(T) < 2 * kHugePage) return;
-    out.reserve(n);
-    const auto begin = reinterpret_cast<std::uintptr_t>(out.data());
-    const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
-    const std::uintptr_t last = (begin + n * sizeof(T)) & ~(kHugePage - 1);
-    if (last > first) {
-      static_cast<void>(::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE));
-    }
-  }
   static std::string formatSeconds(std::chrono::steady_clock::duration d) {
     return fmt::format("{:.0f} s", std::chrono::duration<double>(d).count());
   }
