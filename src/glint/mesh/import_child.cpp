@@ -33,7 +33,7 @@
 #include "glint/core/cancel.h"
 #include "glint/core/file_access.h"
 #include "glint/core/huge_pages.h"
-#include "glint/mesh/assimp_import.h"
+#include "glint/mesh/mesh_reader_wire.h"
 
 namespace glint {
 
@@ -53,58 +53,6 @@ static_assert(std::is_trivially_copyable_v<Material> && std::is_trivially_copyab
 // enough that a corrupt answer cannot make the parent allocate without end.
 constexpr std::uint64_t kMaxEmbeddedImageBytes = std::uint64_t{1} << 30;
 constexpr std::uint64_t kMaxEmbeddedImages = 1 << 16;
-
-// Writes everything or stops silently (the parent sees a short message).
-bool writeAll(int fd, const void* data, std::size_t size) {
-  const char* p = static_cast<const char*>(data);
-  while (size > 0) {
-    const ssize_t n = ::write(fd, p, size);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
-template <typename T>
-bool writeValue(int fd, const T& value) {
-  return writeAll(fd, &value, sizeof value);
-}
-
-template <typename T>
-bool writeVector(int fd, const std::vector<T>& values) {
-  return writeValue(fd, std::uint64_t{values.size()}) &&
-         writeAll(fd, values.data(), values.size() * sizeof(T));
-}
-
-bool writeMessage(int fd, char tag, const std::string& text) {
-  return writeValue(fd, tag) && writeValue(fd, std::uint64_t{text.size()}) &&
-         writeAll(fd, text.data(), text.size());
-}
-
-bool writeMeshFile(int fd, const MeshFile& file) {
-  bool ok = writeValue(fd, 'M') && writeValue(fd, std::uint64_t{file.droppedTriangles}) &&
-            writeValue(fd, std::uint64_t{file.materials.size()});
-  for (const MeshMaterial& m : file.materials) {
-    ok = ok && writeMessage(fd, 'N', m.name) && writeValue(fd, m.material) &&
-         writeValue(fd, m.emission) && writeValue(fd, static_cast<char>(m.fromFile));
-    for (const MeshTexture& t : m.textures) {
-      ok = ok && writeMessage(fd, 'T', t.file) && writeValue(fd, t.embedded);
-    }
-  }
-  ok = ok && writeValue(fd, std::uint64_t{file.embeddedImages.size()});
-  for (const std::vector<std::uint8_t>& image : file.embeddedImages) {
-    ok = ok && writeVector(fd, image);
-  }
-  ok = ok && writeValue(fd, std::uint64_t{file.parts.size()});
-  for (const TriangleMesh& part : file.parts) {
-    ok = ok && writeValue(fd, part.materialIndex) && writeValue(fd, part.emission) &&
-         writeVector(fd, part.positions) && writeVector(fd, part.normals) &&
-         writeVector(fd, part.indices) && writeVector(fd, part.uvs);
-  }
-  return ok;
-}
 
 // While waiting for the child, the parent looks at the cancel flag this often (milliseconds): a
 // cancelled load stops within about this time plus the kill of the child.
@@ -282,7 +230,6 @@ namespace {
 // What the parent and the mesh reader program must agree on: the answer's layout (Material and
 // the other records cross as raw bytes) is that of one build, so a reader from another glint
 // version is refused.
-constexpr const char* kMeshReaderProtocol = "glint-mesh-reader/" GLINT_VERSION "/1";
 
 // The mesh reader program: GLINT_MESH_READER when set; else the first that exists of
 // glint-mesh-reader beside the running program (the build tree, a program linked with the
@@ -371,7 +318,7 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
   // The child's arguments, made before the fork: between fork and execve the child may only make
   // async-signal-safe calls (no allocation).
   const std::vector<std::string> arguments = {reader.string(),
-                                              kMeshReaderProtocol,
+                                              wire::kMeshReaderProtocol,
                                               std::to_string(fds[1]),
                                               std::to_string(answer),
                                               std::to_string(gChildDelayMilliseconds.load()),
@@ -416,7 +363,7 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
       ::execve(argv[0], argv.data(), envp.data());
     }
     const int error = errno;
-    static_cast<void>(writeValue(fds[1], 'X') && writeValue(fds[1], error));
+    static_cast<void>(wire::writeValue(fds[1], 'X') && wire::writeValue(fds[1], error));
     ::_exit(127);
   }
   ::close(fds[1]);
@@ -461,58 +408,6 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
   }
   if (!file) throw MeshLoadError(failure);
   return std::move(*file);
-}
-
-int runMeshReader(int argc, char** argv) {
-  // Arguments (importMeshInChild): protocol, answer pipe, answer file (-1: none), delay in ms,
-  // extension, scene folder, mesh file.
-  if (argc != 8) {
-    std::fprintf(stderr, "%s: glint starts this program to read mesh files; it is not run alone\n",
-                 argc > 0 ? argv[0] : kMeshReaderProgram);
-    return 2;
-  }
-  const int pipe = std::atoi(argv[2]);
-  const int answer = std::atoi(argv[3]);
-  if (std::string_view(argv[1]) != kMeshReaderProtocol) {
-    writeMessage(pipe, 'E',
-                 fmt::format("cannot read it: the mesh reader {} is from another glint build ({}, "
-                             "not {})",
-                             argv[0], argv[1], kMeshReaderProtocol));
-    return 2;
-  }
-  // Large blocks from the heap rather than each from its own mmap: assimp's OBJ reader and the
-  // post-processing free buffers of megabytes (the file, a line buffer of the file's size, the
-  // meshes PreTransformVertices replaces) that later ones then reuse instead of faulting in
-  // fresh pages (~4 ms of a 100k-triangle OBJ). 32 MiB is the most glibc accepts. The program
-  // ends with _exit, so its heap is never given back in any case.
-  ::mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  if (const long delay = std::atol(argv[4]); delay > 0) {
-    const timespec pause{static_cast<time_t>(delay / 1000), (delay % 1000) * 1000000};
-    ::nanosleep(&pause, nullptr);
-  }
-  const std::filesystem::path path = argv[7];
-  MeshFile result;
-  std::string error;
-  try {
-    result = importMesh(path, argv[5], ReferencedFileRule(path, argv[6]));
-  } catch (const MeshLoadError& e) {
-    error = e.what();
-  } catch (...) {
-    error = "invalid file: the mesh library failed reading it";
-  }
-  const auto send = [&](int fd) {
-    return error.empty() ? writeMeshFile(fd, result) : writeMessage(fd, 'E', error);
-  };
-  if (answer >= 0 && send(answer)) {
-    writeValue(pipe, 'D');
-    ::_exit(0);
-  }
-  // A partly written memory file would hold its pages until the parent closes it, after the
-  // whole answer has come through the pipe as well: under the memory pressure that made the
-  // write fail, give them back first.
-  if (answer >= 0) static_cast<void>(::ftruncate(answer, 0));
-  if (writeValue(pipe, 'P')) send(pipe);
-  ::_exit(0);
 }
 
 }  // namespace glint

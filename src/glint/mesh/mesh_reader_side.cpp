@@ -1,0 +1,102 @@
+// The mesh reader program's side of the import in a child process (import_child.h): reads one
+// file with importMesh (assimp, or glint's own OBJ parse) and writes the answer. Its own
+// translation unit so that the renderer, which only starts the reader, does not link assimp.
+#include <malloc.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "glint/mesh/assimp_import.h"
+#include "glint/mesh/import_child.h"
+#include "glint/mesh/mesh_reader_wire.h"
+
+namespace glint {
+
+namespace wire {
+
+bool writeMeshFile(int fd, const MeshFile& file) {
+  bool ok = writeValue(fd, 'M') && writeValue(fd, std::uint64_t{file.droppedTriangles}) &&
+            writeValue(fd, std::uint64_t{file.materials.size()});
+  for (const MeshMaterial& m : file.materials) {
+    ok = ok && writeMessage(fd, 'N', m.name) && writeValue(fd, m.material) &&
+         writeValue(fd, m.emission) && writeValue(fd, static_cast<char>(m.fromFile));
+    for (const MeshTexture& t : m.textures) {
+      ok = ok && writeMessage(fd, 'T', t.file) && writeValue(fd, t.embedded);
+    }
+  }
+  ok = ok && writeValue(fd, std::uint64_t{file.embeddedImages.size()});
+  for (const std::vector<std::uint8_t>& image : file.embeddedImages) {
+    ok = ok && writeVector(fd, image);
+  }
+  ok = ok && writeValue(fd, std::uint64_t{file.parts.size()});
+  for (const TriangleMesh& part : file.parts) {
+    ok = ok && writeValue(fd, part.materialIndex) && writeValue(fd, part.emission) &&
+         writeVector(fd, part.positions) && writeVector(fd, part.normals) &&
+         writeVector(fd, part.indices) && writeVector(fd, part.uvs);
+  }
+  return ok;
+}
+
+}  // namespace wire
+
+int runMeshReader(int argc, char** argv) {
+  // Arguments (importMeshInChild): protocol, answer pipe, answer file (-1: none), delay in ms,
+  // extension, scene folder, mesh file.
+  if (argc != 8) {
+    std::fprintf(stderr, "%s: glint starts this program to read mesh files; it is not run alone\n",
+                 argc > 0 ? argv[0] : kMeshReaderProgram);
+    return 2;
+  }
+  const int pipe = std::atoi(argv[2]);
+  const int answer = std::atoi(argv[3]);
+  if (std::string_view(argv[1]) != wire::kMeshReaderProtocol) {
+    wire::writeMessage(
+        pipe, 'E',
+        fmt::format("cannot read it: the mesh reader {} is from another glint build ({}, "
+                    "not {})",
+                    argv[0], argv[1], wire::kMeshReaderProtocol));
+    return 2;
+  }
+  // Large blocks from the heap rather than each from its own mmap: assimp's OBJ reader and the
+  // post-processing free buffers of megabytes (the file, a line buffer of the file's size, the
+  // meshes PreTransformVertices replaces) that later ones then reuse instead of faulting in
+  // fresh pages (~4 ms of a 100k-triangle OBJ). 32 MiB is the most glibc accepts. The program
+  // ends with _exit, so its heap is never given back in any case.
+  ::mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  if (const long delay = std::atol(argv[4]); delay > 0) {
+    const timespec pause{static_cast<time_t>(delay / 1000), (delay % 1000) * 1000000};
+    ::nanosleep(&pause, nullptr);
+  }
+  const std::filesystem::path path = argv[7];
+  MeshFile result;
+  std::string error;
+  try {
+    result = importMesh(path, argv[5], ReferencedFileRule(path, argv[6]));
+  } catch (const MeshLoadError& e) {
+    error = e.what();
+  } catch (...) {
+    error = "invalid file: the mesh library failed reading it";
+  }
+  const auto send = [&](int fd) {
+    return error.empty() ? wire::writeMeshFile(fd, result) : wire::writeMessage(fd, 'E', error);
+  };
+  if (answer >= 0 && send(answer)) {
+    wire::writeValue(pipe, 'D');
+    ::_exit(0);
+  }
+  // A partly written memory file would hold its pages until the parent closes it, after the
+  // whole answer has come through the pipe as well: under the memory pressure that made the
+  // write fail, give them back first.
+  if (answer >= 0) static_cast<void>(::ftruncate(answer, 0));
+  if (wire::writeValue(pipe, 'P')) send(pipe);
+  ::_exit(0);
+}
+
+}  // namespace glint
