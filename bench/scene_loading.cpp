@@ -106,6 +106,21 @@ ChildRun inChild(Work&& work) {
   return run;
 }
 
+// `glint check SCENE` in a child process (its output dropped); nullopt, with a message, when it
+// fails.
+std::optional<ChildRun> runGlintCheck(const fs::path& scene) {
+  const ChildRun check = inChild([&] {
+    std::freopen("/dev/null", "w", stdout);
+    ::execl(GLINT_CLI_PATH, "glint", "check", scene.c_str(), static_cast<char*>(nullptr));
+    return 127;
+  });
+  if (!WIFEXITED(check.status) || WEXITSTATUS(check.status) != 0) {
+    fmt::print(stderr, "glint check failed\n");
+    return std::nullopt;
+  }
+  return check;
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0 : v[v.size() / 2];
@@ -258,16 +273,9 @@ int objLoading(int triangles, const fs::path& dir, const glint::bench::CommonOpt
       static std::optional<glint::MeshFile> first;
       if (!first) first = loaded;
       same = same && sameMesh(*first, loaded);
-      const ChildRun check = inChild([&] {
-        std::freopen("/dev/null", "w", stdout);
-        ::execl(GLINT_CLI_PATH, "glint", "check", scene.c_str(), static_cast<char*>(nullptr));
-        return 127;
-      });
-      if (!WIFEXITED(check.status) || WEXITSTATUS(check.status) != 0) {
-        fmt::print(stderr, "glint check failed\n");
-        return 1;
-      }
-      t.check.push_back(check.seconds);
+      const std::optional<ChildRun> check = runGlintCheck(scene);
+      if (!check) return 1;
+      t.check.push_back(check->seconds);
     }
   }
   ::unsetenv("GLINT_OBJ_READER");
@@ -314,17 +322,10 @@ int main(int argc, char** argv) {
   std::vector<double> checkSeconds, builtSeconds;
   long checkPeak = 0, builtPeak = 0;
   for (int r = 0; r < runs; ++r) {
-    const ChildRun check = inChild([&] {
-      std::freopen("/dev/null", "w", stdout);
-      ::execl(GLINT_CLI_PATH, "glint", "check", scene.c_str(), static_cast<char*>(nullptr));
-      return 127;
-    });
-    if (!WIFEXITED(check.status) || WEXITSTATUS(check.status) != 0) {
-      fmt::print(stderr, "glint check failed\n");
-      return 1;
-    }
-    checkSeconds.push_back(check.seconds);
-    checkPeak = std::max(checkPeak, check.peakKiB);
+    const std::optional<ChildRun> check = runGlintCheck(scene);
+    if (!check) return 1;
+    checkSeconds.push_back(check->seconds);
+    checkPeak = std::max(checkPeak, check->peakKiB);
     // The same scene built from memory: primitives, materials, camera, BVH — no file.
     const ChildRun built = inChild([&] {
       glint::SceneParts parts;

@@ -362,18 +362,26 @@ TEST(PathIntegrator, MisAndEachStrategyAloneConvergeToTheSameImage) {
   expectEachStrategyAgreesWithMis(parts);
 }
 
-// The same agreement for the emitters sampled by their surfaces' areas beyond triangles and
-// spheres: a rotated box, a capped cylinder under a similarity, a cone frustum and an ellipse
-// (a disk under a non-uniform scale) light a diffuse floor; a wrong area or density in any of
-// them would part light sampling from BRDF sampling.
-TEST(PathIntegrator, BoxesCylindersConesAndEllipsesAreSampledAsLights) {
+// A 12×12 view from (0, 2, 6) down onto a diffuse floor (kd 0.6) at y = 0, 1024 samples, and a
+// black material for emitters (index returned in `dark`): the stage of the emitter tests below.
+SceneParts floorForEmitters(std::uint32_t& dark) {
   SceneParts parts = cameraParts(12, 12);
   parts.camera.position = {0, 2, 6};
   parts.camera.direction = normalize(Vec3{0, -0.35, -1});
   parts.image.samples = 1024;
   parts.primitives.emplace_back(Plane::make({0, 0, 0}, {0, 1, 0}),
                                 addMaterial(parts, diffuse(Color(0.6))), Color{});
-  const std::uint32_t dark = addMaterial(parts, diffuse(Color(0)));
+  dark = addMaterial(parts, diffuse(Color(0)));
+  return parts;
+}
+
+// The same agreement for the emitters sampled by their surfaces' areas beyond triangles and
+// spheres: a rotated box, a capped cylinder under a similarity, a cone frustum and an ellipse
+// (a disk under a non-uniform scale) light a diffuse floor; a wrong area or density in any of
+// them would part light sampling from BRDF sampling.
+TEST(PathIntegrator, BoxesCylindersConesAndEllipsesAreSampledAsLights) {
+  std::uint32_t dark = 0;
+  SceneParts parts = floorForEmitters(dark);
   Matrix4 turn = Matrix4::identity();  // 90° about y, scaled by 0.5, moved up
   turn.m[0][2] = 0.5;
   turn.m[2][0] = -0.5;
@@ -401,13 +409,8 @@ TEST(PathIntegrator, BoxesCylindersConesAndEllipsesAreSampledAsLights) {
 // stays a sphere and is sampled; once under a non-uniform scale, where it is an ellipsoid and is
 // left to BRDF sampling), and a two-triangle emissive mesh in another. The three strategies agree.
 TEST(PathIntegrator, EmittersInsideInstancesAreSampledAsLights) {
-  SceneParts parts = cameraParts(12, 12);
-  parts.camera.position = {0, 2, 6};
-  parts.camera.direction = normalize(Vec3{0, -0.35, -1});
-  parts.image.samples = 1024;
-  parts.primitives.emplace_back(Plane::make({0, 0, 0}, {0, 1, 0}),
-                                addMaterial(parts, diffuse(Color(0.6))), Color{});
-  const std::uint32_t dark = addMaterial(parts, diffuse(Color(0)));
+  std::uint32_t dark = 0;
+  SceneParts parts = floorForEmitters(dark);
   GroupParts lamps;
   lamps.primitives.emplace_back(Sphere::make({0, 0, 0}, 0.25), dark, Color(10, 8, 6));
   lamps.primitives.emplace_back(Rectangle::make({-0.3, 0.6, -0.3}, {0.6, 0, 0}, {0, 0, 0.6}), dark,
