@@ -512,59 +512,34 @@ int childCountOf(const Node& node) {
   return count;
 }
 
-// Appends the 8-wide node whose children are `slots` (child slots of 4-wide nodes, in depth-first
-// order; count ≤ 8) and its subtree to out; returns its index. First the inner children of largest
-// area are pulled up while their children fit (in place, keeping the order); then runs of adjacent
-// inner children whose children fit in eight slots together become one 8-wide child (its box the
-// union of theirs), so that the nodes above the leaves hold eight children, not four.
-std::uint32_t collapseNode(const std::vector<Node>& nodes, std::array<SlotRef, Node8::kWidth> slots,
-                           int count, std::vector<Node8>& out) {
-  const auto innerOf = [&](const SlotRef& ref) -> std::uint32_t {
-    return nodes[ref.node].child[ref.slot];
-  };
-  const auto isInner = [&](const SlotRef& ref) { return nodes[ref.node].info[ref.slot] == kInner; };
+// Appends the 8-wide node made of 4-wide node `index` and its subtree to out; returns its index.
+std::uint32_t collapseNode(const std::vector<Node>& nodes, std::uint32_t index,
+                           std::vector<Node8>& out) {
+  std::array<SlotRef, Node8::kWidth> slots;
+  int count = 0;
+  for (int i = 0; i < childCountOf(nodes[index]); ++i) slots[count++] = {index, i};
   while (true) {
     // The inner child of largest area whose children fit in the free slots (the first of equals).
     int pick = -1;
     float pickArea = -1;
     for (int i = 0; i < count; ++i) {
-      if (!isInner(slots[i])) continue;
-      const int grandchildren = childCountOf(nodes[innerOf(slots[i])]);
+      const Node& parent = nodes[slots[i].node];
+      if (parent.info[slots[i].slot] != kInner) continue;
+      const int grandchildren = childCountOf(nodes[parent.child[slots[i].slot]]);
       if (count - 1 + grandchildren > Node8::kWidth) continue;
-      const float area = childHalfArea(nodes[slots[i].node], slots[i].slot);
+      const float area = childHalfArea(parent, slots[i].slot);
       if (area > pickArea) {
         pickArea = area;
         pick = i;
       }
     }
     if (pick < 0) break;
-    const std::uint32_t pulled = innerOf(slots[pick]);
+    const std::uint32_t pulled = nodes[slots[pick].node].child[slots[pick].slot];
     const int grandchildren = childCountOf(nodes[pulled]);
     // Shift the slots after pick right and put the pulled node's children in its place.
     for (int i = count - 1; i > pick; --i) slots[i + grandchildren - 1] = slots[i];
     for (int k = 0; k < grandchildren; ++k) slots[pick + k] = {pulled, k};
     count += grandchildren - 1;
-  }
-
-  // The children of the new node: slots [begin, end) each; a leaf alone, or a run of inner ones.
-  struct Group {
-    int begin, end;
-    int grandchildren;
-  };
-  std::array<Group, Node8::kWidth> groups;
-  int groupCount = 0;
-  for (int i = 0; i < count; ++i) {
-    const int grandchildren = isInner(slots[i]) ? childCountOf(nodes[innerOf(slots[i])]) : 0;
-    if (groupCount > 0 && grandchildren > 0) {
-      Group& last = groups[groupCount - 1];
-      if (last.grandchildren > 0 && last.end == i &&
-          last.grandchildren + grandchildren <= Node8::kWidth) {
-        last.end = i + 1;
-        last.grandchildren += grandchildren;
-        continue;
-      }
-    }
-    groups[groupCount++] = {i, i + 1, grandchildren};
   }
 
   const auto wideIndex = static_cast<std::uint32_t>(out.size());
@@ -575,29 +550,18 @@ std::uint32_t collapseNode(const std::vector<Node>& nodes, std::array<SlotRef, N
       wide.bounds[axis + 3][i] = -kInf;
     }
   }
-  for (int g = 0; g < groupCount; ++g) {
-    for (int i = groups[g].begin; i < groups[g].end; ++i) {
-      const Node& parent = nodes[slots[i].node];
-      const int s = slots[i].slot;
-      for (int axis = 0; axis < 3; ++axis) {
-        wide.bounds[axis][g] = std::min(wide.bounds[axis][g], parent.bounds[axis][s]);
-        wide.bounds[axis + 3][g] = std::max(wide.bounds[axis + 3][g], parent.bounds[axis + 3][s]);
-      }
-      wide.child[g] = parent.child[s];
-      wide.info[g] = parent.info[s];
-    }
+  for (int i = 0; i < count; ++i) {
+    const Node& parent = nodes[slots[i].node];
+    const int s = slots[i].slot;
+    for (int row = 0; row < 6; ++row) wide.bounds[row][i] = parent.bounds[row][s];
+    wide.child[i] = parent.child[s];
+    wide.info[i] = parent.info[s];
   }
   out.push_back(wide);
-  for (int g = 0; g < groupCount; ++g) {
-    if (groups[g].grandchildren == 0) continue;
-    std::array<SlotRef, Node8::kWidth> below;
-    int belowCount = 0;
-    for (int i = groups[g].begin; i < groups[g].end; ++i) {
-      const std::uint32_t inner = innerOf(slots[i]);
-      for (int k = 0; k < childCountOf(nodes[inner]); ++k) below[belowCount++] = {inner, k};
-    }
-    const std::uint32_t child = collapseNode(nodes, below, belowCount, out);
-    out[wideIndex].child[g] = child;
+  for (int i = 0; i < count; ++i) {
+    if (out[wideIndex].info[i] != kInner) continue;
+    const std::uint32_t child = collapseNode(nodes, out[wideIndex].child[i], out);
+    out[wideIndex].child[i] = child;
   }
   return wideIndex;
 }
@@ -640,10 +604,7 @@ std::vector<Node8> collapseToWide(const std::vector<Node>& nodes) {
   std::vector<Node8> wide;
   if (nodes.empty()) return wide;
   wide.reserve(nodes.size() / 2 + 1);
-  std::array<SlotRef, Node8::kWidth> rootSlots;
-  const int rootCount = childCountOf(nodes[0]);
-  for (int i = 0; i < rootCount; ++i) rootSlots[i] = {0, i};
-  collapseNode(nodes, rootSlots, rootCount, wide);
+  collapseNode(nodes, 0, wide);
   wide.shrink_to_fit();
   return wide;
 }

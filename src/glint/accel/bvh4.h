@@ -79,14 +79,13 @@ struct Tree {
 // stitched in depth-first order and every reduction is an exact min/max/count.
 Tree build(std::vector<BuildItem>& items);
 
-// The 8-wide tree of a 4-wide one (nodes, root an inner node at index 0). Each 8-wide node starts
-// from a 4-wide node's children (or several siblings' children) and pulls up the children of its
-// inner children, largest surface area first, while they fit in eight slots; then adjacent inner
-// children whose children fit in eight slots together become one 8-wide child (its box the union
-// of theirs), which fills the nodes just above the leaves. Pulled-up and merged children keep
-// their place, so a walk that visits children in slot order meets the leaves in the 4-wide tree's
-// depth-first order. Leaves and their boxes are copied bit for bit (a slab test of a leaf's box
-// answers the same in either tree), and the result is depth-first with the root at 0.
+// The 8-wide tree of a 4-wide one (nodes, root an inner node at index 0): each 8-wide node takes
+// a 4-wide node's children and pulls up the children of its inner children, largest surface area
+// first, while they fit in eight slots. A pulled-up node's children take its slot, in their order,
+// so the children of every 8-wide node are in the 4-wide tree's depth-first order: a traversal
+// that visits children in slot order meets the leaves in the same order in both trees. Leaves and
+// child boxes are copied bit for bit (a slab test of a leaf's box answers the same in either), and
+// the result is depth-first with the root at 0.
 std::vector<Node8> collapseToWide(const std::vector<Node>& nodes);
 
 inline constexpr std::uint32_t kMaxLeafSize = 8;
