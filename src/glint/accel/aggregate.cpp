@@ -1,6 +1,6 @@
 // The Aggregate: input validation, build references for primitives and mesh triangles, and the two
-// traversals of the 4-wide BVH (closest hit near-child-first, transmittance in any order), plus the
-// brute-force loops they are measured and tested against.
+// traversals of the 4- or 8-wide BVH (closest hit near-child-first, transmittance in slot order),
+// plus the brute-force loops they are measured and tested against.
 //
 // Compiled once per instruction set (core/isa.h): as itself for the baseline, and included by
 // aggregate_avx2.cpp and aggregate_avx512.cpp, which define GLINT_ISA_KERNEL (the ISA's suffix of
@@ -385,7 +385,9 @@ int bvhNodeWidth(Isa isa) {
     throw IsaError("GLINT_BVH_WIDTH is \"" + std::string(width) +
                    "\"; it must be 4 or 8 (children per BVH node)");
   }
-  return isa == Isa::Baseline ? 4 : 8;
+  // Per ISA, as measured (docs/benchmarks.md): 8-wide nodes gave no gain beyond the noise.
+  constexpr std::array<int, 3> kWidthOf = {4, 4, 4};  // baseline, avx2, avx512
+  return kWidthOf[static_cast<std::size_t>(isa)];
 }
 
 int Aggregate::nodeWidth() const { return nodeWidth_; }

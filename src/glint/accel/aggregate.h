@@ -51,8 +51,9 @@ struct Hit {
 enum class Acceleration { Bvh, BruteForce, Bvh4, Bvh8 };
 
 // The node width Acceleration::Bvh builds for the kernels of `isa`: GLINT_BVH_WIDTH (4 or 8) when
-// set and not empty, else 8 for Avx2 and Avx512 and 4 for Baseline (docs/benchmarks.md has the
-// measurements). Throws IsaError for another GLINT_BVH_WIDTH.
+// set and not empty, else 4 for every ISA — 8-wide nodes measured no faster with the AVX2 and
+// AVX-512 kernels and take ~9 more bytes per triangle (docs/benchmarks.md, "Instruction sets").
+// Throws IsaError for another GLINT_BVH_WIDTH.
 int bvhNodeWidth(Isa isa);
 
 class Aggregate {

@@ -1,6 +1,6 @@
-// The 4-wide bounding volume hierarchy of the Aggregate: node layout, child references, and the
-// parallel, deterministic binned-SAH build over tagged references (analytic primitives and mesh
-// triangles in one tree).
+// The bounding volume hierarchy of the Aggregate: 4- and 8-wide node layouts, child references, the
+// parallel, deterministic binned-SAH build of 4-wide nodes over tagged references (analytic
+// primitives and mesh triangles in one tree), and its collapse into 8-wide nodes.
 #pragma once
 
 #include <cstdint>

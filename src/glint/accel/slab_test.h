@@ -1,6 +1,6 @@
 // The ray-box slab test the BVH traversals share (the Aggregate's tree and the instances' top-level
-// tree): a ray set up once per traversal (BoxRay), and one SSE test of a node's four child boxes
-// against an interval of t, conservative in single precision.
+// tree): a ray set up once per traversal (BoxRay), one SSE test of a node's four child boxes, or
+// one AVX test of an 8-wide node's eight, against an interval of t, conservative in floats.
 #pragma once
 
 #include <emmintrin.h>
