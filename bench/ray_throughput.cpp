@@ -2,11 +2,14 @@
 // (issue 4, bench 1): Mrays/s per scene × ray set × query × thread count, the ratio glint/Embree,
 // the 2-thread speedups, and both BVH build times.
 //
-//   ray_throughput [--runs N] [--quick] [--no-packets] [--embree-isa ISA] [--isas]
+//   ray_throughput [--runs N] [--quick] [--no-packets] [--embree-isa ISA] [--isas] [--widths]
 //
-// glint runs its default kernels (GLINT_ISA, else the widest this CPU runs: core/isa.h); with
-// --isas every ISA this CPU runs, one column each, alternating with Embree within every run, and
-// the rows check that all of them gave the same answers bit for bit.
+// glint runs its default kernels (GLINT_ISA, else the widest this CPU runs: core/isa.h) on the
+// BVH node width they use (bvhNodeWidth: GLINT_BVH_WIDTH, else 8 for AVX2/AVX-512, 4 for the
+// baseline); with --isas every ISA this CPU runs, one column each, and with --widths each ISA on
+// both node widths (a 4-wide and an 8-wide Aggregate of the same scene) with the ratio
+// 8-wide/4-wide per ISA. All columns alternate with Embree within every run, and the rows check
+// that all of them gave the same answers bit for bit.
 //
 // Scenes: a 100k- and a 1M-triangle torus over a two-triangle floor, and 1000 spheres (glint:
 // analytic spheres; Embree: RTC_GEOMETRY_TYPE_SPHERE_POINT, a true ray–sphere intersection) over
@@ -14,11 +17,13 @@
 // in the scene bounds, directions uniform on the sphere). Queries: closest hit (glint intersect,
 // rtcIntersect1) and shadow over (0, ∞) (glint transmittance with every kt = 0, rtcOccluded1).
 // glint works in double precision, Embree in single; both get the same rays, converted once.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench_scenes.h"
@@ -37,12 +42,26 @@ struct Row {
   Query query;
   int threads;
   std::size_t rayCount;
-  std::vector<Timing> glint;  // one per ISA measured (the glint column(s)), in the order of `isas`
+  std::vector<Timing> glint;  // one per column measured, in the order of `columns`
   Timing embree1, embree16;
   double agreement = 0;    // fraction of rays where glint and Embree give the same answer
   double hitFraction = 0;  // of glint's answers: hit / occluded
-  bool isasAgree = true;   // every ISA gave the same answers, bit for bit
+  bool isasAgree = true;   // every column gave the same answers, bit for bit
   const Timing& widest() const { return glint.back(); }
+};
+
+// A glint column: the kernels of `isa` on the tree of `width` children per node.
+struct Column {
+  Isa isa;
+  int width;
+  std::string name() const { return std::string(isaName(isa)) + "/" + std::to_string(width); }
+};
+
+// The scene's Aggregates, one per node width measured.
+struct Aggregates {
+  std::optional<Aggregate> four;
+  std::optional<Aggregate> eight;
+  Aggregate& at(const Column& column) { return column.width == 8 ? *eight : *four; }
 };
 
 double mrays(std::size_t count, const Timing& t) {
@@ -58,10 +77,11 @@ bool sameHit(double tGlint, float tEmbree) {
 }
 
 Row measure(const std::string& sceneName, const RaySet& set, const std::vector<FloatRay>& floatRays,
-            Aggregate& aggregate, const std::vector<Isa>& isas, RTCScene embree, Query query,
-            int threads, int runs, bool packets) {
+            Aggregates& aggregates, const std::vector<Column>& columns, RTCScene embree,
+            Query query, int threads, int runs, bool packets) {
   Row row{sceneName, set.name, query, threads, set.rays.size(), {}, {}, {}, 0, 0, true};
-  row.glint.resize(isas.size());
+  row.glint.resize(columns.size());
+  Aggregate* aggregate = nullptr;  // the column being run
   const std::size_t n = set.rays.size();
   tbb::task_arena arena(threads);
   std::vector<double> tGlint(n);
@@ -76,13 +96,13 @@ Row measure(const std::string& sceneName, const RaySet& set, const std::vector<F
       forBlocks(arena, n, [&](std::size_t b, std::size_t e) {
         Hit hit;
         for (std::size_t i = b; i < e; ++i) {
-          tGlint[i] = aggregate.intersect(rays[i], 0, kInfinity, hit) ? hit.t : kInfinity;
+          tGlint[i] = aggregate->intersect(rays[i], 0, kInfinity, hit) ? hit.t : kInfinity;
         }
       });
     } else {
       forBlocks(arena, n, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
-          occGlint[i] = isBlack(aggregate.transmittance(rays[i], 0, kInfinity)) ? 1 : 0;
+          occGlint[i] = isBlack(aggregate->transmittance(rays[i], 0, kInfinity)) ? 1 : 0;
         }
       });
     }
@@ -105,14 +125,18 @@ Row measure(const std::string& sceneName, const RaySet& set, const std::vector<F
   };
 
   // One untimed warm-up of each (page faults, caches, TBB workers), then the runs interleaved so
-  // that a change in machine load hits every side alike. Each ISA's first answers are kept to
+  // that a change in machine load hits every side alike. The first column's answers are kept to
   // check that the others give the same bits.
+  const auto select = [&](const Column& column) {
+    aggregate = &aggregates.at(column);
+    aggregate->setIsa(column.isa);
+  };
   std::vector<double> firstT;
   std::vector<std::uint8_t> firstOcc;
-  for (const Isa isa : isas) {
-    aggregate.setIsa(isa);
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    select(columns[k]);
     runGlint();
-    if (isa == isas.front()) {
+    if (k == 0) {
       firstT = tGlint;
       firstOcc = occGlint;
     } else {
@@ -122,8 +146,8 @@ Row measure(const std::string& sceneName, const RaySet& set, const std::vector<F
   runEmbree(false);
   if (packets) runEmbree(true);
   for (int r = 0; r < runs; ++r) {
-    for (std::size_t k = 0; k < isas.size(); ++k) {
-      aggregate.setIsa(isas[k]);
+    for (std::size_t k = 0; k < columns.size(); ++k) {
+      select(columns[k]);
       row.glint[k].seconds.push_back(runGlint());
     }
     row.embree1.seconds.push_back(runEmbree(false));
@@ -146,31 +170,51 @@ Row measure(const std::string& sceneName, const RaySet& set, const std::vector<F
   return row;
 }
 
-void printRowHeader(bool packets, const std::vector<Isa>& isas) {
-  std::printf("%-12s %-7s %-8s %3s |", "scene", "rays", "query", "thr");
-  for (const Isa isa : isas) {
-    const std::string title = "glint " + std::string(isaName(isa)) + " Mrays/s";
-    std::printf(" %-18s |", title.c_str());
+// Pairs of columns (4-wide, 8-wide) of the same ISA, for the width ratio columns.
+std::vector<std::pair<std::size_t, std::size_t>> widthPairs(const std::vector<Column>& columns) {
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    for (std::size_t j = 0; j < columns.size(); ++j) {
+      if (columns[i].isa == columns[j].isa && columns[i].width == 4 && columns[j].width == 8) {
+        pairs.emplace_back(i, j);
+      }
+    }
   }
-  std::printf(" %-18s |", "Embree-1 Mrays/s");
-  for (const Isa isa : isas) {
-    const std::string title = std::string(isaName(isa)) + "/Embree";
-    std::printf(" %15s |", title.c_str());
-  }
-  std::printf("%s %6s | %9s%s\n", packets ? " Embree-16 Mrays/s  |" : "", "hits", "agree",
-              isas.size() > 1 ? " | ISAs same" : "");
+  return pairs;
 }
 
-void printRow(const Row& r, bool packets) {
+void printRowHeader(bool packets, const std::vector<Column>& columns) {
+  std::printf("%-12s %-7s %-8s %3s |", "scene", "rays", "query", "thr");
+  for (const Column& c : columns) {
+    const std::string title = "glint " + c.name() + " Mrays/s";
+    std::printf(" %-20s |", title.c_str());
+  }
+  std::printf(" %-20s |", "Embree-1 Mrays/s");
+  for (const Column& c : columns) {
+    const std::string title = c.name() + "/Embree";
+    std::printf(" %15s |", title.c_str());
+  }
+  for (const auto& [four, eight] : widthPairs(columns)) {
+    const std::string title = std::string(isaName(columns[four].isa)) + " 8/4";
+    std::printf(" %11s |", title.c_str());
+  }
+  std::printf("%s %6s | %9s%s\n", packets ? " Embree-16 Mrays/s    |" : "", "hits", "agree",
+              columns.size() > 1 ? " | all same" : "");
+}
+
+void printRow(const Row& r, const std::vector<Column>& columns, bool packets) {
   std::printf("%-12s %-7s %-8s %3d |", r.scene.c_str(), r.rays.c_str(),
               r.query == Query::Closest ? "closest" : "shadow", r.threads);
   for (const Timing& t : r.glint)
-    std::printf(" %8.2f ±%5.1f%%   |", mrays(r.rayCount, t), t.spreadPercent());
-  std::printf(" %8.2f ±%5.1f%%   |", mrays(r.rayCount, r.embree1), r.embree1.spreadPercent());
+    std::printf(" %8.2f ±%5.1f%%     |", mrays(r.rayCount, t), t.spreadPercent());
+  std::printf(" %8.2f ±%5.1f%%     |", mrays(r.rayCount, r.embree1), r.embree1.spreadPercent());
   for (const Timing& t : r.glint)
     std::printf(" %15.2f |", mrays(r.rayCount, t) / mrays(r.rayCount, r.embree1));
+  for (const auto& [four, eight] : widthPairs(columns)) {
+    std::printf(" %11.3f |", mrays(r.rayCount, r.glint[eight]) / mrays(r.rayCount, r.glint[four]));
+  }
   if (packets) {
-    std::printf(" %8.2f ±%5.1f%%   |", mrays(r.rayCount, r.embree16), r.embree16.spreadPercent());
+    std::printf(" %8.2f ±%5.1f%%     |", mrays(r.rayCount, r.embree16), r.embree16.spreadPercent());
   }
   std::printf(" %5.1f%% | %8.4f%%%s\n", 100 * r.hitFraction, 100 * r.agreement,
               r.glint.size() > 1 ? (r.isasAgree ? " | yes" : " | NO") : "");
@@ -180,15 +224,17 @@ void printRow(const Row& r, bool packets) {
 int run(int argc, char** argv) {
   const std::string usage =
       "usage: ray_throughput [--runs N] [--quick] [--no-packets] [--embree-isa ISA] [--isas]\n"
+      "                      [--widths]\n"
       "  --runs N      repetitions per figure (median printed; default 5)\n"
       "  --quick       10k-triangle torus instead of 1M, 256x192 rays (smoke test)\n"
       "  --no-packets  skip the informative Embree 16-ray packet column\n"
       "  --embree-isa ISA  run Embree's kernels for ISA (sse2, sse4.2, avx, avx2, avx512) instead\n"
       "                of the widest this CPU has\n"
       "  --isas        every glint ISA this CPU runs (baseline, avx2, avx512) side by side, not\n"
-      "                only the default one (GLINT_ISA, else the widest)\n";
+      "                only the default one (GLINT_ISA, else the widest)\n"
+      "  --widths      each ISA on 4-wide and on 8-wide BVH nodes, not only on its default width\n";
   std::vector<ExtraOption> extra{
-      {"--no-packets", false}, {"--embree-isa", true}, {"--isas", false}};
+      {"--no-packets", false}, {"--embree-isa", true}, {"--isas", false}, {"--widths", false}};
   const CommonOptions options = parseCommonOptions(argc, argv, usage, &extra);
   const bool packets = !extra[0].present;
   printHeader("ray throughput: glint vs Embree", options);
@@ -202,8 +248,21 @@ int run(int argc, char** argv) {
       if (isaSupportHere().runs(isa)) isas.push_back(isa);
     }
   }
-  std::printf("glint kernels:");
-  for (const Isa isa : isas) std::printf(" %s", std::string(isaName(isa)).c_str());
+  std::vector<Column> columns;
+  for (const Isa isa : isas) {
+    if (extra[3].present) {
+      columns.push_back({isa, 4});
+      columns.push_back({isa, 8});
+    } else {
+      columns.push_back({isa, bvhNodeWidth(isa)});
+    }
+  }
+  const auto usesWidth = [&](int width) {
+    return std::any_of(columns.begin(), columns.end(),
+                       [width](const Column& c) { return c.width == width; });
+  };
+  std::printf("glint kernels (ISA/node width):");
+  for (const Column& c : columns) std::printf(" %s", c.name().c_str());
   std::printf(" (the widest this CPU runs: %s)\n",
               std::string(isaName(bestIsa(isaSupportHere()))).c_str());
 
@@ -229,13 +288,20 @@ int run(int argc, char** argv) {
   std::printf(
       "\n-- ray throughput (Mrays/s, median ± half range; glint/Embree uses Embree-1 = "
       "rtcIntersect1/rtcOccluded1) --\n");
-  printRowHeader(packets, isas);
+  printRowHeader(packets, columns);
   std::vector<Row> rows;
   for (const BenchScene& scene : scenes) {
-    std::optional<Aggregate> aggregate;
+    Aggregates aggregates;
     {
       tbb::task_arena arena(2);
-      arena.execute([&] { aggregate.emplace(buildAggregate(makeGlintInputs(scene))); });
+      arena.execute([&] {
+        if (usesWidth(4)) {
+          aggregates.four.emplace(buildAggregate(makeGlintInputs(scene), Acceleration::Bvh4));
+        }
+        if (usesWidth(8)) {
+          aggregates.eight.emplace(buildAggregate(makeGlintInputs(scene), Acceleration::Bvh8));
+        }
+      });
     }
     EmbreeScene embree(device, scene.meshes, scene.spheres);
     embree.commit();
@@ -247,9 +313,9 @@ int run(int argc, char** argv) {
       const std::vector<FloatRay> floatRays = toFloatRays(set.rays);
       for (Query query : {Query::Closest, Query::Shadow}) {
         for (int threads : threadCounts) {
-          rows.push_back(measure(scene.name, set, floatRays, *aggregate, isas, embree.get(), query,
-                                 threads, options.runs, packets));
-          printRow(rows.back(), packets);
+          rows.push_back(measure(scene.name, set, floatRays, aggregates, columns, embree.get(),
+                                 query, threads, options.runs, packets));
+          printRow(rows.back(), columns, packets);
         }
       }
     }
@@ -257,7 +323,7 @@ int run(int argc, char** argv) {
 
   // 2-thread speedups, and the issue-4 targets over every row.
   std::printf("\n-- 2-thread speedup (Mrays/s at 2 threads / at 1 thread; glint: %s) --\n",
-              std::string(isaName(isas.back())).c_str());
+              columns.back().name().c_str());
   std::printf("%-12s %-7s %-8s | %13s | %14s\n", "scene", "rays", "query", "glint speedup",
               "Embree speedup");
   double worstRatio = 1e300, worstSpeedup = 1e300;
@@ -275,12 +341,12 @@ int run(int argc, char** argv) {
     worstRatio = std::min(worstRatio, mrays(r.rayCount, r.widest()) / mrays(r.rayCount, r.embree1));
     isasAgree = isasAgree && r.isasAgree;
   }
-  if (isas.size() > 1) {
-    std::printf("\nevery ISA gave the same answers on every row: %s\n", isasAgree ? "yes" : "NO");
+  if (columns.size() > 1) {
+    std::printf("\nevery column gave the same answers on every row: %s\n",
+                isasAgree ? "yes" : "NO");
   }
   std::printf("\ntargets (glint %s): glint/Embree >= 0.80 on every row: worst %.2f -> %s\n",
-              std::string(isaName(isas.back())).c_str(), worstRatio,
-              worstRatio >= 0.8 ? "MET" : "NOT MET");
+              columns.back().name().c_str(), worstRatio, worstRatio >= 0.8 ? "MET" : "NOT MET");
   std::printf("         2-thread speedup >= 1.85 on every row: worst %.2f -> %s\n", worstSpeedup,
               worstSpeedup >= 1.85 ? "MET" : "NOT MET");
   std::printf("load average at the end: %s\n", loadAverage().c_str());

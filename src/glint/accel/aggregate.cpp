@@ -1,6 +1,6 @@
 // The Aggregate: input validation, build references for primitives and mesh triangles, and the two
-// traversals of the 4-wide BVH (closest hit near-child-first, transmittance in any order), plus the
-// brute-force loops they are measured and tested against.
+// traversals of the 4- or 8-wide BVH (closest hit near-child-first, transmittance in slot order),
+// plus the brute-force loops they are measured and tested against.
 //
 // Compiled once per instruction set (core/isa.h): as itself for the baseline, and included by
 // aggregate_avx2.cpp and aggregate_avx512.cpp, which define GLINT_ISA_KERNEL (the ISA's suffix of
@@ -17,9 +17,11 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 
@@ -39,9 +41,11 @@ using bvh::kEmpty;
 using bvh::kInner;
 using bvh::kPrimitiveKey;
 using bvh::Node;
+using bvh::Node8;
 using slab::BoxRay;
 using slab::floatAbove;
 using slab::floatBelow;
+using slab::intersectHalf;
 using slab::intersectNode;
 using slab::kFarScale;
 using slab::StackEntry;
@@ -126,6 +130,97 @@ inline bool crossesTriangle(const WatertightRay& wray, const Vec3& direction,
   return (h.u != 0 && h.v != 0 && h.w != 0) || ownsTouchingHit(wray, v, h);
 }
 
+// The slab test of a node's children for one traversal (slab_test.h): the ray, and the interval
+// of t as floats in every lane; test returns a bit per child whose box the interval overlaps and
+// can store the entry distances.
+template <class NodeType>
+class ChildTest;
+
+template <>
+class ChildTest<Node> {
+ public:
+  ChildTest(const BoxRay& ray, float tMin, float tMax)
+      : ray_(ray), tMin_(_mm_set1_ps(tMin)), tMax_(_mm_set1_ps(tMax)) {}
+  void setTMax(float tMax) { tMax_ = _mm_set1_ps(tMax); }
+  unsigned test(const Node& node) const {
+    __m128 tNear;
+    return static_cast<unsigned>(intersectNode(node, ray_, tMin_, tMax_, tNear));
+  }
+  unsigned test(const Node& node, float* tNear) const {
+    __m128 t;
+    const int mask = intersectNode(node, ray_, tMin_, tMax_, t);
+    _mm_store_ps(tNear, t);
+    return static_cast<unsigned>(mask);
+  }
+
+ private:
+  const BoxRay& ray_;
+  __m128 tMin_;
+  __m128 tMax_;
+};
+
+#ifdef __AVX2__
+// The AVX2 and AVX-512 kernels: one 256-bit test of all eight children.
+template <>
+class ChildTest<Node8> {
+ public:
+  ChildTest(const BoxRay& ray, float tMin, float tMax)
+      : ray_(ray), tMin_(_mm256_set1_ps(tMin)), tMax_(_mm256_set1_ps(tMax)) {}
+  void setTMax(float tMax) { tMax_ = _mm256_set1_ps(tMax); }
+  unsigned test(const Node8& node) const {
+    __m256 tNear;
+    return static_cast<unsigned>(intersectNode(node, ray_, tMin_, tMax_, tNear));
+  }
+  unsigned test(const Node8& node, float* tNear) const {
+    __m256 t;
+    const int mask = intersectNode(node, ray_, tMin_, tMax_, t);
+    _mm256_store_ps(tNear, t);
+    return static_cast<unsigned>(mask);
+  }
+
+ private:
+  slab::WideBoxRay ray_;
+  __m256 tMin_;
+  __m256 tMax_;
+};
+#else
+// The baseline kernels on an 8-wide tree: two SSE tests of four children each.
+template <>
+class ChildTest<Node8> {
+ public:
+  ChildTest(const BoxRay& ray, float tMin, float tMax)
+      : ray_(ray), tMin_(_mm_set1_ps(tMin)), tMax_(_mm_set1_ps(tMax)) {}
+  void setTMax(float tMax) { tMax_ = _mm_set1_ps(tMax); }
+  unsigned test(const Node8& node) const {
+    __m128 low;
+    __m128 high;
+    return static_cast<unsigned>(intersectHalf(node, 0, ray_, tMin_, tMax_, low) |
+                                 intersectHalf(node, 4, ray_, tMin_, tMax_, high) << 4);
+  }
+  unsigned test(const Node8& node, float* tNear) const {
+    __m128 low;
+    __m128 high;
+    const int mask = intersectHalf(node, 0, ray_, tMin_, tMax_, low) |
+                     intersectHalf(node, 4, ray_, tMin_, tMax_, high) << 4;
+    _mm_store_ps(tNear, low);
+    _mm_store_ps(tNear + 4, high);
+    return static_cast<unsigned>(mask);
+  }
+
+ private:
+  const BoxRay& ray_;
+  __m128 tMin_;
+  __m128 tMax_;
+};
+#endif
+
+// Tie ranks of the closest-hit query (see intersect): bounded primitives by index, then triangles
+// by mesh and triangle.
+constexpr std::uint64_t kBoundedPrimitiveRank = std::uint64_t{1} << 62;
+inline std::uint64_t triangleRank(std::uint32_t mesh, std::uint32_t triangle) {
+  return (std::uint64_t{2} << 62) | (static_cast<std::uint64_t>(mesh) << 32) | triangle;
+}
+
 #ifndef GLINT_AGGREGATE_KERNELS_ONLY
 std::string meshName(std::size_t m) { return "mesh " + std::to_string(m); }
 
@@ -207,7 +302,7 @@ Aggregate::Aggregate(std::vector<Primitive> primitives, std::vector<Color> primi
   std::size_t itemCount = 0;
   for (std::uint32_t i = 0; i < primitives_.size(); ++i) {
     const Primitive& p = primitives_[i];
-    if (acceleration_ == Acceleration::Bvh && !p.isBounded()) {
+    if (acceleration_ != Acceleration::BruteForce && !p.isBounded()) {
       unbounded_.push_back(i);
       continue;
     }
@@ -271,7 +366,31 @@ Aggregate::Aggregate(std::vector<Primitive> primitives, std::vector<Color> primi
   rootChild_ = tree.rootChild;
   rootInfo_ = tree.rootInfo;
   storeInLeafOrder(items);
+  const bool wide = acceleration_ == Acceleration::Bvh8 ||
+                    (acceleration_ == Acceleration::Bvh && bvhNodeWidth(kernels_->isa) == 8);
+  nodeWidth_ = wide ? 8 : 4;
+  if (wide && rootInfo_ == kInner) {
+    wideNodes_ = bvh::collapseToWide(nodes_);
+    std::vector<Node>().swap(nodes_);
+    rootChild_ = 0;
+  }
 }
+
+int bvhNodeWidth(Isa isa) {
+  const char* forced = std::getenv("GLINT_BVH_WIDTH");
+  if (forced != nullptr && *forced != '\0') {
+    const std::string_view width(forced);
+    if (width == "4") return 4;
+    if (width == "8") return 8;
+    throw IsaError("GLINT_BVH_WIDTH is \"" + std::string(width) +
+                   "\"; it must be 4 or 8 (children per BVH node)");
+  }
+  // Per ISA, as measured (docs/benchmarks.md): 8-wide nodes gave no gain beyond the noise.
+  constexpr std::array<int, 3> kWidthOf = {4, 4, 4};  // baseline, avx2, avx512
+  return kWidthOf[static_cast<std::size_t>(isa)];
+}
+
+int Aggregate::nodeWidth() const { return nodeWidth_; }
 
 // Measured on the 1M-triangle torus with random rays: a triangle test chased leaf reference →
 // mesh index triple → three positions, up to five cache misses with the node's two, and closest
@@ -353,7 +472,7 @@ std::size_t Aggregate::memoryBytes() const {
   bytes += primitives_.capacity() * sizeof(Primitive) + transmission_.capacity() * sizeof(Color) +
            meshTransmission_.capacity() * sizeof(Color) +
            unbounded_.capacity() * sizeof(std::uint32_t) + nodes_.capacity() * sizeof(Node) +
-           leafRefs_.capacity() * sizeof(std::uint32_t) +
+           wideNodes_.capacity() * sizeof(Node8) + leafRefs_.capacity() * sizeof(std::uint32_t) +
            meshBegin_.capacity() * sizeof(std::uint32_t);
   if (instances_) bytes += instances_->memoryBytes();
   return bytes;
@@ -413,26 +532,41 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
     }
   }
 
-  if (rootInfo_ != kEmpty) {
+  // Exact ties in t. The answer is the hit of least (t, rank), whatever order the tree is walked
+  // in (node width, ISA, near-child order): an unbounded primitive (rank 0: the loop above keeps
+  // the first of equals) before a bounded primitive (by index) before a mesh triangle (by mesh,
+  // then triangle in leaf order, the same numbering for every width). Elements are tested against
+  // `limit`: tMax (exclusive) until the tree finds a hit, then the next double above `closest`, so
+  // an element at exactly `closest` is seen and the ranks decide.
+  std::uint64_t bestRank = 0;
+  double limit = closest;
+  const auto accept = [&](double t, std::uint64_t rank) {
+    if (t == closest && found != Found::None && !(rank < bestRank)) return false;
+    closest = t;
+    bestRank = rank;
+    limit = nextUp(closest);
+    return true;
+  };
+  const auto traverse = [&](const auto* nodes) {
+    using NodeType = std::remove_cvref_t<decltype(*nodes)>;
+    constexpr int kWidth = NodeType::kWidth;
     const BoxRay boxRay(ray);
     WatertightRay wray;  // set up at the first triangle leaf: analytic scenes never need it
     bool wrayReady = false;
-    const __m128 tMinV = _mm_set1_ps(floatBelow(tMin));
     float closestF = floatAbove(closest * kFarScale);
-    __m128 tMaxV = _mm_set1_ps(closestF);
-    std::array<StackEntry, bvh::kStackSize> stack;
+    ChildTest<NodeType> childTest(boxRay, floatBelow(tMin), closestF);
+    constexpr int kStack = kWidth == 4 ? bvh::kStackSize : bvh::kWideStackSize;
+    std::array<StackEntry, kStack> stack;
     int stackSize = 0;
     std::uint32_t child = rootChild_;
     std::uint32_t info = rootInfo_;
     while (true) {
       if (info == kInner) {
-        const Node& node = nodes_[child];
-        __m128 tNearV;
-        int mask = intersectNode(node, boxRay, tMinV, tMaxV, tNearV);
+        const NodeType& node = nodes[child];
+        alignas(32) std::array<float, kWidth> tNear;
+        unsigned mask = childTest.test(node, tNear.data());
         if (mask != 0) {
-          alignas(16) std::array<float, 4> tNear;
-          _mm_store_ps(tNear.data(), tNearV);
-          const int first = std::countr_zero(static_cast<unsigned>(mask));
+          const int first = std::countr_zero(mask);
           mask &= mask - 1;
           if (mask == 0) {
             child = node.child[first];
@@ -440,11 +574,11 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
             continue;
           }
           // Near child first: visit the nearest entry now, push the others farthest first.
-          std::array<StackEntry, 4> hits;
+          std::array<StackEntry, kWidth> hits;
           int hitCount = 0;
           hits[hitCount++] = {node.child[first], node.info[first], tNear[first]};
           while (mask != 0) {
-            const int i = std::countr_zero(static_cast<unsigned>(mask));
+            const int i = std::countr_zero(mask);
             mask &= mask - 1;
             StackEntry entry{node.child[i], node.info[i], tNear[i]};
             int k = hitCount++;
@@ -466,8 +600,8 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
         if (key == kPrimitiveKey) {
           for (std::uint32_t k = child; k < child + count; ++k) {
             const std::uint32_t index = leafRefs_[k];
-            if (primitives_[index].intersect(ray, tMin, closest, shapeHit)) {
-              closest = shapeHit.t;
+            if (primitives_[index].intersect(ray, tMin, limit, shapeHit) &&
+                accept(shapeHit.t, kBoundedPrimitiveRank | index)) {
               primitiveHit = shapeHit;
               primitiveHitComplete = true;
               hitIndex = index;
@@ -484,11 +618,11 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
           WatertightHit candidate;  // a rejected (parallel) candidate must not overwrite the best
           Vec3 candidateNormal;
           for (std::uint32_t triangle = child; triangle < child + count; ++triangle) {
-            if (hitTriangle(wray, ray.direction, verticesOf(mesh, triangle), tMin, closest,
-                            candidate, candidateNormal)) {
+            if (hitTriangle(wray, ray.direction, verticesOf(mesh, triangle), tMin, limit, candidate,
+                            candidateNormal) &&
+                accept(candidate.t, triangleRank(key, triangle))) {
               triangleHit = candidate;
               triangleNormal = candidateNormal;
-              closest = candidate.t;
               hitIndex = triangle;
               hitMesh = key;
               found = Found::Triangle;
@@ -498,15 +632,22 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
         }
         if (closer) {
           closestF = floatAbove(closest * kFarScale);
-          tMaxV = _mm_set1_ps(closestF);
+          childTest.setTMax(closestF);
         }
       }
-      // Pop the next entry that can still hold something closer.
+      // Pop the next entry that can still hold something closer (or as close: a tie).
       while (stackSize > 0 && stack[stackSize - 1].tNear > closestF) --stackSize;
       if (stackSize == 0) break;
       --stackSize;
       child = stack[stackSize].child;
       info = stack[stackSize].info;
+    }
+  };
+  if (rootInfo_ != kEmpty) {
+    if (wideNodes_.empty()) {
+      traverse(nodes_.data());
+    } else {
+      traverse(wideNodes_.data());
     }
   }
 
@@ -553,67 +694,75 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
   }
   if (rootInfo_ == kEmpty) return result;
 
-  // Every crossing counts, so the order of the visit does not change the result and the interval
-  // never shrinks. Children are visited in slot order, not nearest first: measured on the 100k
-  // torus over its floor (camera rays), sorting made the query 3× slower, and merely taking the
-  // nearest child first 3–5× slower (100k / 1M triangles), since the large occluders (the floor)
-  // sit near the root and end the query at once.
-  const BoxRay boxRay(ray);
-  WatertightRay wray;  // set up at the first triangle leaf: analytic scenes never need it
-  bool wrayReady = false;
-  const __m128 tMinV = _mm_set1_ps(floatBelow(tMin));
-  const __m128 tMaxV = _mm_set1_ps(floatAbove(tMax * kFarScale));
-  std::array<std::uint64_t, bvh::kStackSize> stack;  // child | info << 32
-  int stackSize = 0;
-  std::uint32_t child = rootChild_;
-  std::uint32_t info = rootInfo_;
-  while (true) {
-    if (info == kInner) {
-      const Node& node = nodes_[child];
-      __m128 tNear;
-      int mask = intersectNode(node, boxRay, tMinV, tMaxV, tNear);
-      if (mask != 0) {
-        const int first = std::countr_zero(static_cast<unsigned>(mask));
-        mask &= mask - 1;
-        while (mask != 0) {
-          const int i = std::countr_zero(static_cast<unsigned>(mask));
+  // Every crossing counts, so the set of crossings does not depend on the order of the visit and
+  // the interval never shrinks. Children are visited in slot order, depth first, not nearest first:
+  // measured on the 100k torus over its floor (camera rays), sorting made the query 3× slower, and
+  // merely taking the nearest child first 3–5× slower (100k / 1M triangles), since the large
+  // occluders (the floor) sit near the root and end the query at once. Slot order is also the
+  // order of the leaves in either node width (bvh::collapseToWide), so the product of the kt
+  // factors is multiplied in the same order, and rounds the same, whatever the width.
+  const auto traverse = [&](const auto* nodes) {
+    using NodeType = std::remove_cvref_t<decltype(*nodes)>;
+    constexpr int kWidth = NodeType::kWidth;
+    const BoxRay boxRay(ray);
+    WatertightRay wray;  // set up at the first triangle leaf: analytic scenes never need it
+    bool wrayReady = false;
+    const ChildTest<NodeType> childTest(boxRay, floatBelow(tMin), floatAbove(tMax * kFarScale));
+    constexpr int kStack = kWidth == 4 ? bvh::kStackSize : bvh::kWideStackSize;
+    std::array<std::uint64_t, kStack> stack;  // child | info << 32
+    int stackSize = 0;
+    std::uint32_t child = rootChild_;
+    std::uint32_t info = rootInfo_;
+    while (true) {
+      if (info == kInner) {
+        const NodeType& node = nodes[child];
+        unsigned mask = childTest.test(node);
+        if (mask != 0) {
+          const int first = std::countr_zero(mask);
           mask &= mask - 1;
-          stack[stackSize++] = node.child[i] | static_cast<std::uint64_t>(node.info[i]) << 32;
-        }
-        child = node.child[first];
-        info = node.info[first];
-        continue;
-      }
-    } else {
-      const std::uint32_t count = bvh::leafCount(info);
-      const std::uint32_t key = bvh::leafKey(info);
-      if (key == kPrimitiveKey) {
-        for (std::uint32_t k = child; k < child + count; ++k) {
-          if (!cross(leafRefs_[k])) return Color();
-        }
-      } else if (const Color& kt = meshTransmission_[key]; !(kt == Color(1))) {
-        const TriangleMesh& mesh = meshes_[key];
-        if (!wrayReady) {
-          wray = WatertightRay(ray);
-          wrayReady = true;
-        }
-        const bool opaque = isBlack(kt);
-        for (std::uint32_t triangle = child; triangle < child + count; ++triangle) {
-          if (!crossesTriangle(wray, ray.direction, verticesOf(mesh, triangle), tMin, tMax)) {
-            continue;
+          // The others last slot first, so that they come off the stack in slot order.
+          while (mask != 0) {
+            const int i = std::bit_width(mask) - 1;
+            mask &= ~(1u << i);
+            stack[stackSize++] = node.child[i] | static_cast<std::uint64_t>(node.info[i]) << 32;
           }
-          if (opaque) return Color();
-          result *= kt;
-          if (isBlack(result)) return Color();
+          child = node.child[first];
+          info = node.info[first];
+          continue;
+        }
+      } else {
+        const std::uint32_t count = bvh::leafCount(info);
+        const std::uint32_t key = bvh::leafKey(info);
+        if (key == kPrimitiveKey) {
+          for (std::uint32_t k = child; k < child + count; ++k) {
+            if (!cross(leafRefs_[k])) return false;
+          }
+        } else if (const Color& kt = meshTransmission_[key]; !(kt == Color(1))) {
+          const TriangleMesh& mesh = meshes_[key];
+          if (!wrayReady) {
+            wray = WatertightRay(ray);
+            wrayReady = true;
+          }
+          const bool opaque = isBlack(kt);
+          for (std::uint32_t triangle = child; triangle < child + count; ++triangle) {
+            if (!crossesTriangle(wray, ray.direction, verticesOf(mesh, triangle), tMin, tMax)) {
+              continue;
+            }
+            if (opaque) return false;
+            result *= kt;
+            if (isBlack(result)) return false;
+          }
         }
       }
+      if (stackSize == 0) break;
+      const std::uint64_t entry = stack[--stackSize];
+      child = static_cast<std::uint32_t>(entry);
+      info = static_cast<std::uint32_t>(entry >> 32);
     }
-    if (stackSize == 0) break;
-    const std::uint64_t entry = stack[--stackSize];
-    child = static_cast<std::uint32_t>(entry);
-    info = static_cast<std::uint32_t>(entry >> 32);
-  }
-  return result;
+    return true;
+  };
+  const bool open = wideNodes_.empty() ? traverse(nodes_.data()) : traverse(wideNodes_.data());
+  return open ? result : Color();
 }
 
 #ifndef GLINT_AGGREGATE_KERNELS_ONLY

@@ -1,7 +1,8 @@
 // The frozen collection of primitives and mesh triangles with its two queries: closest hit, and
-// shadow transmittance. Bounded primitives and all mesh triangles go into one 4-wide bounding
-// volume hierarchy (bvh4.h: binned SAH build, flat node array, near-child-first traversal with SSE
-// slab tests); unbounded primitives (planes, tubes) are tested on every ray.
+// shadow transmittance. Bounded primitives and all mesh triangles go into one bounding volume
+// hierarchy (bvh4.h: binned SAH build of 4-wide nodes, optionally collapsed into 8-wide ones; flat
+// node array, near-child-first traversal with SIMD slab tests); unbounded primitives (planes,
+// tubes) are tested on every ray.
 #pragma once
 
 #include <cstdint>
@@ -43,8 +44,17 @@ struct Hit {
 };
 
 // How the Aggregate organises its primitives: a BVH, or none (every ray tests every primitive —
-// only for measuring what the BVH buys).
-enum class Acceleration { Bvh, BruteForce };
+// only for measuring what the BVH buys). Bvh chooses the node width for the ISA the Aggregate
+// starts with (bvhNodeWidth); Bvh4 and Bvh8 force one (tests and benchmarks). Every width finds
+// the same hits bit for bit: the 8-wide tree is the 4-wide one collapsed (bvh::collapseToWide),
+// with the same leaves, boxes and triangle numbering.
+enum class Acceleration { Bvh, BruteForce, Bvh4, Bvh8 };
+
+// The node width Acceleration::Bvh builds for the kernels of `isa`: GLINT_BVH_WIDTH (4 or 8) when
+// set and not empty, else 4 for every ISA — 8-wide nodes measured no faster with the AVX2 and
+// AVX-512 kernels and take ~9 more bytes per triangle (docs/benchmarks.md, "Instruction sets").
+// Throws IsaError for another GLINT_BVH_WIDTH.
+int bvhNodeWidth(Isa isa);
 
 class Aggregate {
  public:
@@ -100,6 +110,8 @@ class Aggregate {
   // Of the bounded primitives and the mesh triangles (and the bounded instances).
   Bounds3 bounds() const { return bounds_; }
   Acceleration acceleration() const { return acceleration_; }
+  // Children per BVH node: 4 or 8 (0 for BruteForce). Every ISA's kernels traverse either width.
+  int nodeWidth() const;
   // Mesh triangles in the structure (the degenerate ones left out).
   std::size_t triangleCount() const { return triangleCount_; }
   // Heap bytes held for meshes (positions, normals, indices), the tree and its leaf references;
@@ -136,11 +148,14 @@ class Aggregate {
   std::vector<TriangleMesh> meshes_;
   std::vector<Color> meshTransmission_;
   std::vector<std::uint32_t> unbounded_;  // primitives tested on every ray (Bvh only)
-  // Bvh: the 4-wide tree. A primitive leaf points into leafRefs_ (primitive indices in leaf
-  // order); a triangle leaf holds a range of its mesh's triangles, which the build renumbers into
-  // leaf order (BruteForce: leafRefs_ holds the triangles of every mesh, see meshBegin_).
+  // Bvh: the tree, either 4-wide (nodes_) or 8-wide (wideNodes_; nodes_ then empty). A primitive
+  // leaf points into leafRefs_ (primitive indices in leaf order); a triangle leaf holds a range of
+  // its mesh's triangles, which the build renumbers into leaf order (BruteForce: leafRefs_ holds
+  // the triangles of every mesh, see meshBegin_).
   std::vector<bvh::Node> nodes_;
+  std::vector<bvh::Node8> wideNodes_;
   std::vector<std::uint32_t> leafRefs_;
+  int nodeWidth_ = 0;
   std::uint32_t rootChild_ = 0;
   std::uint32_t rootInfo_ = bvh::kEmpty;
   // BruteForce: the non-degenerate triangles of mesh m are leafRefs_[meshBegin_[m] ..

@@ -492,6 +492,80 @@ float roundUp(double x) {
   return std::nextafter(static_cast<float>(x), std::numeric_limits<float>::infinity());
 }
 
+// One child slot of a node during the collapse: the 4-wide node it lives in and its slot there.
+struct SlotRef {
+  std::uint32_t node;
+  int slot;
+};
+
+// Half the surface area of a child box of a 4-wide node (float, as stored).
+float childHalfArea(const Node& node, int slot) {
+  const float dx = node.bounds[3][slot] - node.bounds[0][slot];
+  const float dy = node.bounds[4][slot] - node.bounds[1][slot];
+  const float dz = node.bounds[5][slot] - node.bounds[2][slot];
+  return dx * dy + dy * dz + dz * dx;
+}
+
+int childCountOf(const Node& node) {
+  int count = 0;
+  while (count < Node::kWidth && node.info[count] != kEmpty) ++count;
+  return count;
+}
+
+// Appends the 8-wide node made of 4-wide node `index` and its subtree to out; returns its index.
+std::uint32_t collapseNode(const std::vector<Node>& nodes, std::uint32_t index,
+                           std::vector<Node8>& out) {
+  std::array<SlotRef, Node8::kWidth> slots;
+  int count = 0;
+  for (int i = 0; i < childCountOf(nodes[index]); ++i) slots[count++] = {index, i};
+  while (true) {
+    // The inner child of largest area whose children fit in the free slots (the first of equals).
+    int pick = -1;
+    float pickArea = -1;
+    for (int i = 0; i < count; ++i) {
+      const Node& parent = nodes[slots[i].node];
+      if (parent.info[slots[i].slot] != kInner) continue;
+      const int grandchildren = childCountOf(nodes[parent.child[slots[i].slot]]);
+      if (count - 1 + grandchildren > Node8::kWidth) continue;
+      const float area = childHalfArea(parent, slots[i].slot);
+      if (area > pickArea) {
+        pickArea = area;
+        pick = i;
+      }
+    }
+    if (pick < 0) break;
+    const std::uint32_t pulled = nodes[slots[pick].node].child[slots[pick].slot];
+    const int grandchildren = childCountOf(nodes[pulled]);
+    // Shift the slots after pick right and put the pulled node's children in its place.
+    for (int i = count - 1; i > pick; --i) slots[i + grandchildren - 1] = slots[i];
+    for (int k = 0; k < grandchildren; ++k) slots[pick + k] = {pulled, k};
+    count += grandchildren - 1;
+  }
+
+  const auto wideIndex = static_cast<std::uint32_t>(out.size());
+  Node8 wide{};
+  for (int i = 0; i < Node8::kWidth; ++i) {
+    for (int axis = 0; axis < 3; ++axis) {
+      wide.bounds[axis][i] = kInf;
+      wide.bounds[axis + 3][i] = -kInf;
+    }
+  }
+  for (int i = 0; i < count; ++i) {
+    const Node& parent = nodes[slots[i].node];
+    const int s = slots[i].slot;
+    for (int row = 0; row < 6; ++row) wide.bounds[row][i] = parent.bounds[row][s];
+    wide.child[i] = parent.child[s];
+    wide.info[i] = parent.info[s];
+  }
+  out.push_back(wide);
+  for (int i = 0; i < count; ++i) {
+    if (out[wideIndex].info[i] != kInner) continue;
+    const std::uint32_t child = collapseNode(nodes, out[wideIndex].child[i], out);
+    out[wideIndex].child[i] = child;
+  }
+  return wideIndex;
+}
+
 }  // namespace
 
 BuildItem makeBuildItem(const double lo[3], const double hi[3], std::uint32_t key,
@@ -524,6 +598,15 @@ Tree build(std::vector<BuildItem>& items) {
   tree.rootInfo = kInner;
   tree.nodes.shrink_to_fit();
   return tree;
+}
+
+std::vector<Node8> collapseToWide(const std::vector<Node>& nodes) {
+  std::vector<Node8> wide;
+  if (nodes.empty()) return wide;
+  wide.reserve(nodes.size() / 2 + 1);
+  collapseNode(nodes, 0, wide);
+  wide.shrink_to_fit();
+  return wide;
 }
 
 }  // namespace glint::bvh

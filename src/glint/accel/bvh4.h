@@ -1,6 +1,6 @@
-// The 4-wide bounding volume hierarchy of the Aggregate: node layout, child references, and the
-// parallel, deterministic binned-SAH build over tagged references (analytic primitives and mesh
-// triangles in one tree).
+// The bounding volume hierarchy of the Aggregate: 4- and 8-wide node layouts, child references, the
+// parallel, deterministic binned-SAH build of 4-wide nodes over tagged references (analytic
+// primitives and mesh triangles in one tree), and its collapse into 8-wide nodes.
 #pragma once
 
 #include <cstdint>
@@ -35,11 +35,22 @@ constexpr std::uint32_t leafInfo(std::uint32_t key, std::uint32_t count) {
 // empty slots hold the empty box (lo = +inf, hi = −inf), which no ray enters. 128 bytes, two cache
 // lines, no padding (so equal trees compare equal byte for byte).
 struct alignas(64) Node {
+  static constexpr int kWidth = 4;
   float bounds[6][4];
   std::uint32_t child[4];
   std::uint32_t info[4];
 };
 static_assert(sizeof(Node) == 128);
+
+// The 8-wide node of the AVX2 and AVX-512 kernels: the same layout with eight lanes, for one
+// 256-bit slab test of all eight children (or two SSE tests). 256 bytes, four cache lines.
+struct alignas(64) Node8 {
+  static constexpr int kWidth = 8;
+  float bounds[6][8];
+  std::uint32_t child[8];
+  std::uint32_t info[8];
+};
+static_assert(sizeof(Node8) == 256);
 
 // One reference during the build: its box (float, rounded outward) and what it refers to.
 // lo[3] and hi[3] carry the key and the index (bit patterns), so an item is two SSE registers.
@@ -68,6 +79,15 @@ struct Tree {
 // stitched in depth-first order and every reduction is an exact min/max/count.
 Tree build(std::vector<BuildItem>& items);
 
+// The 8-wide tree of a 4-wide one (nodes, root an inner node at index 0): each 8-wide node takes
+// a 4-wide node's children and pulls up the children of its inner children, largest surface area
+// first, while they fit in eight slots. A pulled-up node's children take its slot, in their order,
+// so the children of every 8-wide node are in the 4-wide tree's depth-first order: a traversal
+// that visits children in slot order meets the leaves in the same order in both trees. Leaves and
+// child boxes are copied bit for bit (a slab test of a leaf's box answers the same in either), and
+// the result is depth-first with the root at 0.
+std::vector<Node8> collapseToWide(const std::vector<Node>& nodes);
+
 inline constexpr std::uint32_t kMaxLeafSize = 8;
 static_assert(kMaxLeafSize <= kCountMask);
 // Deepest possible tree, in 4-wide levels: SAH until kMaxSahDepth, then median splits (each level
@@ -76,5 +96,7 @@ static_assert(kMaxLeafSize <= kCountMask);
 inline constexpr int kMaxSahDepth = 32;
 inline constexpr int kMaxDepth = kMaxSahDepth + 33 + static_cast<int>(kMaxLeafSize);
 inline constexpr int kStackSize = 3 * kMaxDepth + 1;
+// An 8-wide tree is no deeper than the 4-wide one it was collapsed from; 7 entries per level.
+inline constexpr int kWideStackSize = 7 * kMaxDepth + 1;
 
 }  // namespace glint::bvh

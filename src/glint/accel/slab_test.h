@@ -1,9 +1,12 @@
 // The ray-box slab test the BVH traversals share (the Aggregate's tree and the instances' top-level
-// tree): a ray set up once per traversal (BoxRay), and one SSE test of a node's four child boxes
-// against an interval of t, conservative in single precision.
+// tree): a ray set up once per traversal (BoxRay), one SSE test of a node's four child boxes, or
+// one AVX test of an 8-wide node's eight, against an interval of t, conservative in floats.
 #pragma once
 
 #include <emmintrin.h>
+#ifdef __AVX2__
+#include <immintrin.h>  // the 8-wide test in the AVX2 and AVX-512 kernels (aggregate_avx*.cpp)
+#endif
 
 #include <array>
 #include <cstddef>
@@ -17,6 +20,7 @@
 namespace glint::slab {
 
 using bvh::Node;
+using bvh::Node8;
 
 inline constexpr float kFloatMax = std::numeric_limits<float>::max();
 
@@ -91,15 +95,16 @@ inline void broadcastAxes(__m128 v, __m128 (&axes)[3]) {
   axes[2] = _mm_shuffle_ps(v, v, _MM_SHUFFLE(2, 2, 2, 2));
 }
 
-// Byte offsets of the rows of Node::bounds (0–2 low, 3–5 high) a slab test reads per axis, for each
-// octant of the direction (bit a set: component a negative, the near plane is the high one).
+// Byte offsets of the rows of Node::bounds or Node8::bounds (0–2 low, 3–5 high) a slab test reads
+// per axis, for each octant of the direction (bit a set: component a negative, the near plane is
+// the high one).
 struct SlabRows {
   std::array<std::size_t, 3> nearRow;
   std::array<std::size_t, 3> farRow;
 };
-inline constexpr std::array<SlabRows, 8> kSlabRows = [] {
+template <std::size_t kRow>
+inline constexpr std::array<SlabRows, 8> kSlabRowsOf = [] {
   std::array<SlabRows, 8> table{};
-  constexpr std::size_t kRow = sizeof(Node::bounds[0]);
   for (std::size_t signs = 0; signs < 8; ++signs) {
     for (std::size_t axis = 0; axis < 3; ++axis) {
       const std::size_t flip = 3 * ((signs >> axis) & 1u);
@@ -109,6 +114,9 @@ inline constexpr std::array<SlabRows, 8> kSlabRows = [] {
   }
   return table;
 }();
+inline constexpr const std::array<SlabRows, 8>& kSlabRows = kSlabRowsOf<sizeof(Node::bounds[0])>;
+inline constexpr const std::array<SlabRows, 8>& kWideSlabRows =
+    kSlabRowsOf<sizeof(Node8::bounds[0])>;
 
 // What the SSE slab tests of one traversal share. For a positive direction component the near
 // plane is the low one and the origin is rounded up there (down at the far plane), and the other
@@ -121,7 +129,8 @@ struct BoxRay {
   __m128 farOrigin[3];
   __m128 nearInverse[3];
   __m128 farInverse[3];
-  SlabRows rows;
+  SlabRows rows;      // of Node
+  SlabRows wideRows;  // of Node8
 
   explicit BoxRay(const Ray& ray) {
     static_assert(std::is_standard_layout_v<Vec3> && sizeof(Vec3) == 3 * sizeof(double));
@@ -143,7 +152,9 @@ struct BoxRay {
     broadcastAxes(farO, farOrigin);
     broadcastAxes(nearInv, nearInverse);
     broadcastAxes(farInv, farInverse);
-    rows = kSlabRows[static_cast<unsigned>(_mm_movemask_ps(negative)) & 7u];
+    const unsigned octant = static_cast<unsigned>(_mm_movemask_ps(negative)) & 7u;
+    rows = kSlabRows[octant];
+    wideRows = kWideSlabRows[octant];
   }
 };
 
@@ -170,6 +181,73 @@ inline int intersectNode(const Node& node, const BoxRay& r, __m128 tMin, __m128 
   tNear = tn;
   return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
 }
+
+// The SSE test of four lanes of an 8-wide node (lanes `offset` .. offset + 3, offset 0 or 4), the
+// same arithmetic as intersectNode.
+inline int intersectHalf(const Node8& node, int offset, const BoxRay& r, __m128 tMin, __m128 tMax,
+                         __m128& tNear) {
+  __m128 tn = tMin;
+  __m128 tf = tMax;
+  const auto* base = reinterpret_cast<const unsigned char*>(node.bounds) + sizeof(float) * offset;
+  for (int axis = 0; axis < 3; ++axis) {
+    const __m128 n = _mm_mul_ps(
+        _mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + r.wideRows.nearRow[axis])),
+                   r.nearOrigin[axis]),
+        r.nearInverse[axis]);
+    const __m128 f = _mm_mul_ps(
+        _mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + r.wideRows.farRow[axis])),
+                   r.farOrigin[axis]),
+        r.farInverse[axis]);
+    tn = _mm_max_ps(n, tn);
+    tf = _mm_min_ps(f, tf);
+  }
+  tNear = tn;
+  return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
+}
+
+#ifdef __AVX2__
+// BoxRay's registers broadcast to eight lanes, for the 256-bit test of an 8-wide node.
+struct WideBoxRay {
+  __m256 nearOrigin[3];
+  __m256 farOrigin[3];
+  __m256 nearInverse[3];
+  __m256 farInverse[3];
+  SlabRows rows;
+
+  explicit WideBoxRay(const BoxRay& r) : rows(r.wideRows) {
+    for (int axis = 0; axis < 3; ++axis) {
+      nearOrigin[axis] = _mm256_set_m128(r.nearOrigin[axis], r.nearOrigin[axis]);
+      farOrigin[axis] = _mm256_set_m128(r.farOrigin[axis], r.farOrigin[axis]);
+      nearInverse[axis] = _mm256_set_m128(r.nearInverse[axis], r.nearInverse[axis]);
+      farInverse[axis] = _mm256_set_m128(r.farInverse[axis], r.farInverse[axis]);
+    }
+  }
+};
+
+// Slab test of the eight children in one 256-bit pass: lane for lane the arithmetic of
+// intersectNode (subtract, multiply, then max/min with the same operand order, so NaN lanes are
+// ignored alike), hence the same mask bits as two SSE tests.
+inline int intersectNode(const Node8& node, const WideBoxRay& r, __m256 tMin, __m256 tMax,
+                         __m256& tNear) {
+  __m256 tn = tMin;
+  __m256 tf = tMax;
+  const auto* base = reinterpret_cast<const unsigned char*>(node.bounds);
+  for (int axis = 0; axis < 3; ++axis) {
+    const __m256 n = _mm256_mul_ps(
+        _mm256_sub_ps(_mm256_load_ps(reinterpret_cast<const float*>(base + r.rows.nearRow[axis])),
+                      r.nearOrigin[axis]),
+        r.nearInverse[axis]);
+    const __m256 f = _mm256_mul_ps(
+        _mm256_sub_ps(_mm256_load_ps(reinterpret_cast<const float*>(base + r.rows.farRow[axis])),
+                      r.farOrigin[axis]),
+        r.farInverse[axis]);
+    tn = _mm256_max_ps(n, tn);
+    tf = _mm256_min_ps(f, tf);
+  }
+  tNear = tn;
+  return _mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ));
+}
+#endif
 
 struct StackEntry {
   std::uint32_t child;

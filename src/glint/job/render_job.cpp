@@ -10,6 +10,7 @@
 #include <system_error>
 #include <utility>
 
+#include "glint/accel/aggregate.h"
 #include "glint/core/atomic_file.h"
 #include "glint/core/cancel.h"
 #include "glint/core/file_access.h"
@@ -67,7 +68,7 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
   if (!fromFile && spec.output.empty())
     throw JobError(JobFailure::BadInput, "a scene built in code needs an output path");
   // The kernels' ISA: a bad GLINT_ISA is refused even when spec.isa overrides it, since every
-  // Aggregate starts from defaultIsa().
+  // Aggregate starts from defaultIsa(); so is a bad GLINT_BVH_WIDTH (bvhNodeWidth).
   Isa isa = Isa::Baseline;
   try {
     isa = defaultIsa();
@@ -75,6 +76,7 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
       requireIsa(*spec.isa);
       isa = *spec.isa;
     }
+    bvhNodeWidth(isa);
   } catch (const IsaError& error) {
     throw JobError(JobFailure::BadInput, error.what());
   }

@@ -94,8 +94,13 @@ Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materia
   for (std::size_t m = 0; m < parts.meshes.size(); ++m) {
     meshTransmission.push_back(checkMaterial("mesh", m, parts.meshes[m].materialIndex));
   }
+  // The node width of the ISA the queries will run with, not of the one the Aggregate starts with.
+  Acceleration acceleration = parts.acceleration;
+  if (acceleration == Acceleration::Bvh && parts.isa) {
+    acceleration = bvhNodeWidth(*parts.isa) == 8 ? Acceleration::Bvh8 : Acceleration::Bvh4;
+  }
   Aggregate aggregate(std::move(parts.primitives), std::move(transmission), std::move(parts.meshes),
-                      std::move(meshTransmission), parts.acceleration, std::move(instances));
+                      std::move(meshTransmission), acceleration, std::move(instances));
   if (parts.isa) aggregate.setIsa(*parts.isa);
   return aggregate;
 }

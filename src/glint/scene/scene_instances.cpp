@@ -150,13 +150,17 @@ std::shared_ptr<const InstanceSet> buildInstanceSet(SceneParts& parts,
           });
       if (csgKt) pKt[i] = *csgKt;
     }
+    // The node width of the scene's ISA (as in scene.cpp).
+    Acceleration acceleration = parts.acceleration;
+    if (acceleration == Acceleration::Bvh && parts.isa) {
+      acceleration = bvhNodeWidth(*parts.isa) == 8 ? Acceleration::Bvh8 : Acceleration::Bvh4;
+    }
     std::shared_ptr<Aggregate> aggregate =
         lastUse[g] == r
             ? std::make_shared<Aggregate>(std::move(primitives), std::move(pKt),
-                                          std::move(group.meshes), std::move(mKt),
-                                          parts.acceleration)
+                                          std::move(group.meshes), std::move(mKt), acceleration)
             : std::make_shared<Aggregate>(std::move(primitives), std::move(pKt), group.meshes,
-                                          std::move(mKt), parts.acceleration);
+                                          std::move(mKt), acceleration);
     if (parts.isa) aggregate->setIsa(*parts.isa);  // the groups' queries run as the scene's
     aggregates.push_back(std::move(aggregate));
   }
