@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "glint/accel/bvh4.h"
@@ -55,6 +56,13 @@ enum class Acceleration { Bvh, BruteForce, Bvh4, Bvh8 };
 // AVX-512 kernels and take ~9 more bytes per triangle (docs/benchmarks.md, "Instruction sets").
 // Throws IsaError for another GLINT_BVH_WIDTH.
 int bvhNodeWidth(Isa isa);
+
+// The acceleration to build for queries that will run with `isa` (when known): Bvh as that ISA's
+// node width (Bvh4 or Bvh8), any other choice as it is.
+inline Acceleration accelerationFor(Acceleration acceleration, std::optional<Isa> isa) {
+  if (acceleration != Acceleration::Bvh || !isa) return acceleration;
+  return bvhNodeWidth(*isa) == 8 ? Acceleration::Bvh8 : Acceleration::Bvh4;
+}
 
 class Aggregate {
  public:

@@ -95,12 +95,9 @@ Aggregate buildAggregate(SceneParts& parts, const std::vector<Material>& materia
     meshTransmission.push_back(checkMaterial("mesh", m, parts.meshes[m].materialIndex));
   }
   // The node width of the ISA the queries will run with, not of the one the Aggregate starts with.
-  Acceleration acceleration = parts.acceleration;
-  if (acceleration == Acceleration::Bvh && parts.isa) {
-    acceleration = bvhNodeWidth(*parts.isa) == 8 ? Acceleration::Bvh8 : Acceleration::Bvh4;
-  }
   Aggregate aggregate(std::move(parts.primitives), std::move(transmission), std::move(parts.meshes),
-                      std::move(meshTransmission), acceleration, std::move(instances));
+                      std::move(meshTransmission), accelerationFor(parts.acceleration, parts.isa),
+                      std::move(instances));
   if (parts.isa) aggregate.setIsa(*parts.isa);
   return aggregate;
 }

@@ -150,11 +150,8 @@ std::shared_ptr<const InstanceSet> buildInstanceSet(SceneParts& parts,
           });
       if (csgKt) pKt[i] = *csgKt;
     }
-    // The node width of the scene's ISA (as in scene.cpp).
-    Acceleration acceleration = parts.acceleration;
-    if (acceleration == Acceleration::Bvh && parts.isa) {
-      acceleration = bvhNodeWidth(*parts.isa) == 8 ? Acceleration::Bvh8 : Acceleration::Bvh4;
-    }
+    // The node width of the scene's ISA.
+    const Acceleration acceleration = accelerationFor(parts.acceleration, parts.isa);
     std::shared_ptr<Aggregate> aggregate =
         lastUse[g] == r
             ? std::make_shared<Aggregate>(std::move(primitives), std::move(pKt),
