@@ -143,10 +143,13 @@ std::shared_ptr<const InstanceSet> buildInstanceSet(SceneParts& parts,
     std::vector<Primitive> primitives =
         lastUse[g] == r ? std::move(group.primitives) : group.primitives;
     for (std::size_t i = 0; i < primitives.size(); ++i) {
-      const bool overridden = override && takes(group.primitiveTakesMaterial, i);
+      // The kt an operand takes: a copy, since clang 14 (the fuzz build) cannot capture a
+      // structured binding.
+      const std::optional<Color> given =
+          override && takes(group.primitiveTakesMaterial, i) ? override : std::nullopt;
       const std::optional<Color> csgKt =
           setCsgTransmission(primitives[i], [&](std::uint32_t material) {
-            return overridden ? *override : kt(material);  // indices checked above
+            return given ? *given : kt(material);  // indices checked above
           });
       if (csgKt) pKt[i] = *csgKt;
     }
