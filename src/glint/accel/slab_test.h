@@ -158,23 +158,24 @@ struct BoxRay {
   }
 };
 
-// Slab test of the four children against [tMin, tMax]: bit i of the result is set when child i's
-// box overlaps the interval; tNear receives the entry distances. _mm_max_ps/_mm_min_ps return
-// their second operand when either is NaN, so a NaN slab distance leaves the interval unchanged.
-inline int intersectNode(const Node& node, const BoxRay& r, __m128 tMin, __m128 tMax,
-                         __m128& tNear) {
+// The SSE slab test of four children whose boxes are the float rows at `base` (`rows`: each axis'
+// near and far row, as byte offsets for this ray's direction) against [tMin, tMax]: bit i of the
+// result is set when child i's box overlaps the interval; tNear receives the entry distances.
+// _mm_max_ps/_mm_min_ps return their second operand when either is NaN, so a NaN slab distance
+// leaves the interval unchanged.
+inline int intersectFourBoxes(const unsigned char* base, const SlabRows& rows, const BoxRay& r,
+                              __m128 tMin, __m128 tMax, __m128& tNear) {
   __m128 tn = tMin;
   __m128 tf = tMax;
-  const auto* base = reinterpret_cast<const unsigned char*>(node.bounds);
   for (int axis = 0; axis < 3; ++axis) {
     const __m128 n = _mm_mul_ps(
-        _mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + r.rows.nearRow[axis])),
+        _mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + rows.nearRow[axis])),
                    r.nearOrigin[axis]),
         r.nearInverse[axis]);
-    const __m128 f = _mm_mul_ps(
-        _mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + r.rows.farRow[axis])),
-                   r.farOrigin[axis]),
-        r.farInverse[axis]);
+    const __m128 f =
+        _mm_mul_ps(_mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + rows.farRow[axis])),
+                              r.farOrigin[axis]),
+                   r.farInverse[axis]);
     tn = _mm_max_ps(n, tn);
     tf = _mm_min_ps(f, tf);
   }
@@ -182,27 +183,20 @@ inline int intersectNode(const Node& node, const BoxRay& r, __m128 tMin, __m128 
   return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
 }
 
+// Slab test of a 4-wide node's children (intersectFourBoxes).
+inline int intersectNode(const Node& node, const BoxRay& r, __m128 tMin, __m128 tMax,
+                         __m128& tNear) {
+  return intersectFourBoxes(reinterpret_cast<const unsigned char*>(node.bounds), r.rows, r, tMin,
+                            tMax, tNear);
+}
+
 // The SSE test of four lanes of an 8-wide node (lanes `offset` .. offset + 3, offset 0 or 4), the
 // same arithmetic as intersectNode.
 inline int intersectHalf(const Node8& node, int offset, const BoxRay& r, __m128 tMin, __m128 tMax,
                          __m128& tNear) {
-  __m128 tn = tMin;
-  __m128 tf = tMax;
-  const auto* base = reinterpret_cast<const unsigned char*>(node.bounds) + sizeof(float) * offset;
-  for (int axis = 0; axis < 3; ++axis) {
-    const __m128 n = _mm_mul_ps(
-        _mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + r.wideRows.nearRow[axis])),
-                   r.nearOrigin[axis]),
-        r.nearInverse[axis]);
-    const __m128 f = _mm_mul_ps(
-        _mm_sub_ps(_mm_load_ps(reinterpret_cast<const float*>(base + r.wideRows.farRow[axis])),
-                   r.farOrigin[axis]),
-        r.farInverse[axis]);
-    tn = _mm_max_ps(n, tn);
-    tf = _mm_min_ps(f, tf);
-  }
-  tNear = tn;
-  return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
+  return intersectFourBoxes(
+      reinterpret_cast<const unsigned char*>(node.bounds) + sizeof(float) * offset, r.wideRows, r,
+      tMin, tMax, tNear);
 }
 
 #ifdef __AVX2__
