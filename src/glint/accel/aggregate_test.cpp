@@ -191,15 +191,19 @@ struct AggregateInspector {
     return summary;
   }
 
+  // Whether two arrays hold the same bytes (an empty array's data() may be null, which memcmp
+  // must not be given even for zero bytes).
+  template <typename T>
+  static bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+  }
+
   // The bytes that define the tree, for comparing builds.
   static bool sameTree(const Aggregate& x, const Aggregate& y) {
     return x.rootChild_ == y.rootChild_ && x.rootInfo_ == y.rootInfo_ &&
-           x.leafRefs_ == y.leafRefs_ && x.nodes_.size() == y.nodes_.size() &&
-           std::memcmp(x.nodes_.data(), y.nodes_.data(), x.nodes_.size() * sizeof(bvh::Node)) ==
-               0 &&
-           x.wideNodes_.size() == y.wideNodes_.size() &&
-           std::memcmp(x.wideNodes_.data(), y.wideNodes_.data(),
-                       x.wideNodes_.size() * sizeof(bvh::Node8)) == 0;
+           x.leafRefs_ == y.leafRefs_ && sameBytes(x.nodes_, y.nodes_) &&
+           sameBytes(x.wideNodes_, y.wideNodes_);
   }
 
   // The leaves in the order a depth-first walk visiting children in slot order meets them (the
