@@ -29,27 +29,24 @@ constexpr std::uint32_t leafInfo(std::uint32_t key, std::uint32_t count) {
   return kLeafBit | (key << kCountBits) | count;
 }
 
-// Four child boxes in single precision, structure of arrays for one SSE slab test of all four:
-// bounds[0..2] the low x, y, z of the children, bounds[3..5] the high ones. Boxes are rounded
+// Width child boxes in single precision, structure of arrays for one SIMD slab test of all of
+// them: bounds[0..2] the low x, y, z of the children, bounds[3..5] the high ones. Boxes are rounded
 // outward from the double-precision bounds (at least one float ulp), so no hit is ever culled;
-// empty slots hold the empty box (lo = +inf, hi = −inf), which no ray enters. 128 bytes, two cache
-// lines, no padding (so equal trees compare equal byte for byte).
-struct alignas(64) Node {
-  static constexpr int kWidth = 4;
-  float bounds[6][4];
-  std::uint32_t child[4];
-  std::uint32_t info[4];
+// empty slots hold the empty box (lo = +inf, hi = −inf), which no ray enters. No padding (so equal
+// trees compare equal byte for byte).
+template <int Width>
+struct alignas(64) NodeOf {
+  static constexpr int kWidth = Width;
+  float bounds[6][Width];
+  std::uint32_t child[Width];
+  std::uint32_t info[Width];
 };
+// The 4-wide node: one SSE test of all four children; 128 bytes, two cache lines.
+using Node = NodeOf<4>;
 static_assert(sizeof(Node) == 128);
-
-// The 8-wide node of the AVX2 and AVX-512 kernels: the same layout with eight lanes, for one
-// 256-bit slab test of all eight children (or two SSE tests). 256 bytes, four cache lines.
-struct alignas(64) Node8 {
-  static constexpr int kWidth = 8;
-  float bounds[6][8];
-  std::uint32_t child[8];
-  std::uint32_t info[8];
-};
+// The 8-wide node of the AVX2 and AVX-512 kernels: one 256-bit test of all eight children (or two
+// SSE tests); 256 bytes, four cache lines.
+using Node8 = NodeOf<8>;
 static_assert(sizeof(Node8) == 256);
 
 // One reference during the build: its box (float, rounded outward) and what it refers to.
