@@ -20,6 +20,7 @@
 #include <string>
 #include <variant>
 
+#include "glint/core/cache_line.h"
 #include "glint/core/sampler.h"
 #include "glint/core/sampling.h"
 #include "glint/core/spawn.h"
@@ -886,8 +887,11 @@ Color traceCameraRay(const TraceContext& ctx, const Ray& ray, const SampleStream
 // depth a path can reach, at most kPreallocatedDepths (the default max_depth is 10; scene files
 // allow up to 1000, and a scene built in code any value).
 constexpr int kPreallocatedDepths = 64;
-std::vector<Hit> hitStorage(const Scene& scene) {
-  return std::vector<Hit>(
+// On cache lines of its own (core/cache_line.h): written on every ray, while other threads read
+// the scene.
+using HitStorage = std::vector<Hit, CacheLineAllocator<Hit>>;
+HitStorage hitStorage(const Scene& scene) {
+  return HitStorage(
       static_cast<std::size_t>(std::clamp(scene.render().maxDepth, 1, kPreallocatedDepths)));
 }
 
@@ -896,7 +900,7 @@ bool hasVertexColors(const Scene& scene) {
                      [](const TriangleMesh& mesh) { return !mesh.colors.empty(); });
 }
 
-TraceContext makeContext(const Scene& scene, RayCounts& counts, std::vector<Hit>& hits) {
+TraceContext makeContext(const Scene& scene, RayCounts& counts, HitStorage& hits) {
   const RenderSettings& settings = scene.render();
   return TraceContext{scene,
                       counts,
@@ -1136,8 +1140,9 @@ class FirstBatches {
            static_cast<std::size_t>(column - x0_);
   }
   int x0_, y0_, x1_, y1_;
-  std::vector<PixelSamples> samples_;
-  std::vector<double> errors_;
+  // Written per sample by this tile's thread: on cache lines of their own, as the hits are.
+  std::vector<PixelSamples, CacheLineAllocator<PixelSamples>> samples_;
+  std::vector<double, CacheLineAllocator<double>> errors_;
 };
 
 }  // namespace
@@ -1145,7 +1150,7 @@ class FirstBatches {
 Color traceRay(const Scene& scene, const Ray& ray, Rng& rng, RayCounts* counts) {
   RayCounts local;
   RayCounts& target = counts ? *counts : local;
-  std::vector<Hit> hits = hitStorage(scene);
+  HitStorage hits = hitStorage(scene);
   const TraceContext ctx = makeContext(scene, target, hits);
   return traceCameraRay(ctx, ray, SampleStream(rng.nextBits(), 0));
 }
@@ -1286,7 +1291,7 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
     const int x1 = tiles[tile].x1;
     const int y1 = tiles[tile].y1;
     RayCounts counts;
-    std::vector<Hit> hits = hitStorage(scene);
+    HitStorage hits = hitStorage(scene);
     const TraceContext ctx = makeContext(scene, counts, hits);
     std::uint64_t tileNonFinite = 0;
     std::uint64_t tileSamples = 0;
