@@ -55,8 +55,8 @@ int run(int argc, char** argv) {
       "references. The heap-measured column checks it with mallinfo2 (inputs + what the "
       "constructor kept).\nEmbree B/prim: everything its memory monitor reports for the scene "
       "(float vertices, indices, BVH with its triangle layout).\n");
-  std::printf("\ntargets: build <= 2x Embree: worst %.2fx -> %s\n", worstBuildRatio,
-              worstBuildRatio <= 2 ? "MET" : "NOT MET");
+  std::printf("\ntargets: build <= 1.5x Embree (issue 16): worst %.2fx -> %s\n", worstBuildRatio,
+              worstBuildRatio <= 1.5 ? "MET" : "NOT MET");
   std::printf("         <= 64 bytes per triangle incl. the tree: worst %.1f -> %s\n", worstBytes,
               worstBytes <= 64 ? "MET" : "NOT MET");
   std::printf("         (2-thread build speedup, for information: worst %.2f)\n", worstSpeedup);
