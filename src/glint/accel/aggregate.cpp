@@ -24,10 +24,12 @@
 #include <string_view>
 #include <type_traits>
 #include <utility>
+#include <variant>
 
 #include "glint/accel/instances.h"
 #include "glint/accel/slab_test.h"
 #include "glint/core/ulp.h"
+#include "glint/geometry/sphere_intersection.h"
 
 #ifndef GLINT_ISA_KERNEL
 #define GLINT_ISA_KERNEL(name) name##Baseline
@@ -416,6 +418,13 @@ void Aggregate::storeInLeafOrder(const std::vector<bvh::BuildItem>& items) {
     const std::uint32_t key = bvh::itemKey(items[i]);
     (key == kPrimitiveKey ? leafRefs_ : oldTriangle[key])[slot[i]] = bvh::itemIndex(items[i]);
   }
+  leafSpheres_.assign(primitiveRefs, LeafSphere{});
+  for (std::size_t k = 0; k < leafRefs_.size(); ++k) {
+    const Primitive& p = primitives_[leafRefs_[k]];
+    if (const auto* sphere = std::get_if<Sphere>(&p.shape()); sphere && !p.worldFromObject()) {
+      leafSpheres_[k] = {sphere->center, sphere->radius};
+    }
+  }
   for (Node& node : nodes_) {
     for (int k = 0; k < 4; ++k) {
       if (bvh::isLeaf(node.info[k])) node.child[k] = slot[node.child[k]];
@@ -473,6 +482,7 @@ std::size_t Aggregate::memoryBytes() const {
            meshTransmission_.capacity() * sizeof(Color) +
            unbounded_.capacity() * sizeof(std::uint32_t) + nodes_.capacity() * sizeof(Node) +
            wideNodes_.capacity() * sizeof(Node8) + leafRefs_.capacity() * sizeof(std::uint32_t) +
+           leafSpheres_.capacity() * sizeof(LeafSphere) +
            meshBegin_.capacity() * sizeof(std::uint32_t);
   if (instances_) bytes += instances_->memoryBytes();
   return bytes;
@@ -600,8 +610,13 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
         if (key == kPrimitiveKey) {
           for (std::uint32_t k = child; k < child + count; ++k) {
             const std::uint32_t index = leafRefs_[k];
-            if (primitives_[index].intersect(ray, tMin, limit, shapeHit) &&
-                accept(shapeHit.t, kBoundedPrimitiveRank | index)) {
+            const LeafSphere& sphere = leafSpheres_[k];
+            // An untransformed sphere inline, exactly as Primitive::intersect would test it.
+            const bool hitIt = sphere.radius > 0
+                                   ? quadric::sphereIntersect(sphere.center, sphere.radius, ray,
+                                                              tMin, limit, shapeHit)
+                                   : primitives_[index].intersect(ray, tMin, limit, shapeHit);
+            if (hitIt && accept(shapeHit.t, kBoundedPrimitiveRank | index)) {
               primitiveHit = shapeHit;
               primitiveHitComplete = true;
               hitIndex = index;
@@ -676,21 +691,25 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
   if (acceleration_ == Acceleration::BruteForce) return transmittanceBruteForce(ray, tMin, tMax);
   Color result(1);
   // Multiplies in kt once per crossing of primitive `index`; false once the product is black.
-  const auto cross = [&](std::uint32_t index) {
+  // `sphere`: its leaf record (radius 0 when it is not an untransformed sphere, or unknown).
+  const auto cross = [&](std::uint32_t index, const LeafSphere& sphere) {
     const Color& kt = transmission_[index];
     if (kt == Color(1)) return true;  // fully transparent: crossings cannot change the product
     if (primitives_[index].csg() != nullptr) {  // each crossing with its operand's kt
       result *= primitives_[index].csgTransmittance(ray, tMin, tMax);
       return !isBlack(result);
     }
-    const int crossings = primitives_[index].crossings(ray, tMin, tMax);
+    // An untransformed sphere inline, exactly as Primitive::crossings would count it.
+    const int crossings =
+        sphere.radius > 0 ? quadric::sphereCrossings(sphere.center, sphere.radius, ray, tMin, tMax)
+                          : primitives_[index].crossings(ray, tMin, tMax);
     if (crossings == 0) return true;
     if (isBlack(kt)) return false;
     for (int k = 0; k < crossings; ++k) result *= kt;
     return !isBlack(result);
   };
   for (const std::uint32_t index : unbounded_) {
-    if (!cross(index)) return Color();
+    if (!cross(index, LeafSphere{})) return Color();
   }
   if (rootInfo_ == kEmpty) return result;
 
@@ -735,7 +754,7 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
         const std::uint32_t key = bvh::leafKey(info);
         if (key == kPrimitiveKey) {
           for (std::uint32_t k = child; k < child + count; ++k) {
-            if (!cross(leafRefs_[k])) return false;
+            if (!cross(leafRefs_[k], leafSpheres_[k])) return false;
           }
         } else if (const Color& kt = meshTransmission_[key]; !(kt == Color(1))) {
           const TriangleMesh& mesh = meshes_[key];

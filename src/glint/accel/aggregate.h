@@ -163,6 +163,13 @@ class Aggregate {
   std::vector<bvh::Node> nodes_;
   std::vector<bvh::Node8> wideNodes_;
   std::vector<std::uint32_t> leafRefs_;
+  // Bvh: per primitive slot of leafRefs_, the centre and radius of an untransformed sphere, which
+  // the queries test inline (geometry/sphere_intersection.h); radius 0 for any other primitive.
+  struct LeafSphere {
+    Point3 center;
+    double radius = 0;
+  };
+  std::vector<LeafSphere> leafSpheres_;
   int nodeWidth_ = 0;
   std::uint32_t rootChild_ = 0;
   std::uint32_t rootInfo_ = bvh::kEmpty;

@@ -13,11 +13,16 @@
 #include "glint/geometry/csg.h"
 #include "glint/geometry/object_space.h"
 #include "glint/geometry/shape.h"
+#include "glint/geometry/sphere_intersection.h"
 #include "glint/geometry/watertight_triangle.h"
 
 namespace glint {
 
 namespace {
+
+using quadric::inOpenRange;
+using quadric::quadricRoots;
+using quadric::wholeQuadricBehind;
 
 // kParallelBound (watertight_triangle.h) also bounds "the direction is along a tube's axis".
 
@@ -152,25 +157,12 @@ bool planeParameter(const Point3& point, const Normal3& n, const Ray& ray, doubl
   return true;
 }
 
-bool inOpenRange(double t, double tMin, double tMax) { return t > tMin && t < tMax; }
-
 // Whether the quotient num/den can be > 0, decided from the signs alone: a quotient of operands of
 // opposite signs (or a zero, or a NaN numerator) is ≤ 0 or NaN and can never lie in an interval
 // (tMin, tMax) with tMin ≥ 0. Exact — it only skips a division whose result the range test would
 // reject.
 bool positiveQuotientPossible(double num, double den) {
   return (num > 0 && den > 0) || (num < 0 && den < 0);
-}
-
-// Whether the sphere (or the tube's cross-section) relative to the ray origin, f = origin − centre,
-// lies wholly behind the ray: the origin is outside or on it (|f|² − r² ≥ 0) and the ray does not
-// move toward the centre (−f·d ≤ 0, −0 included). quadricRoots returns then, in floating point as
-// well, roots t0 = c/q and t1 = q/a with q = b − √Δ < 0, c ≥ 0 and a > 0, both ≤ 0 (or NaN), so no
-// root lies in (tMin, tMax) when tMin ≥ 0. Shadow and reflection rays leaving a sphere meet this
-// case for the sphere they leave; deciding it here skips the root computation (a square root and
-// three divisions).
-bool wholeQuadricBehind(double b, double c, double tMin) {
-  return tMin >= 0 && std::signbit(b) && c >= 0;
 }
 
 // --- hit points with error bounds (core/spawn.h states the policy these serve) ---
@@ -216,28 +208,6 @@ void boxHitPoint(const Ray& ray, double t, int axis, double face, ShapeHit& hit)
   Vec3 e = (abs(toVec(ray.origin)) + abs(ray.direction * t)) * gammaBound(3);
   e[axis] = 0;
   hit.pointError = e;
-}
-
-// Roots t0 < t1 of |f + t·d|² = r² (f = origin relative to the centre, d the direction; both
-// already projected onto the cross-section for tubes), by the method of Ray Tracing Gems ch. 7
-// ("Precision Improvements for Ray/Sphere Intersection", Haines et al. 2019): the discriminant from
-// the squared distance of the line to the centre, r² − |f − (f·d̂)d̂|², which does not cancel
-// catastrophically for distant rays, and the root pair from q = b + sign(b)·√Δ
-// (t0 = c/q, t1 = q/a), which avoids subtracting nearly equal numbers. A tangent line (Δ ≤ 0) has
-// no roots.
-[[gnu::always_inline]] inline bool quadricRoots(const Vec3& f, const Vec3& d, double r, double& t0,
-                                                double& t1) {
-  const double a = dot(d, d);
-  const double b = -dot(f, d);
-  const Vec3 closest = f + d * (b / a);  // centre-to-line offset at the closest approach
-  const double discriminant = a * (r * r - dot(closest, closest));
-  if (!(discriminant > 0)) return false;
-  const double c = dot(f, f) - r * r;
-  const double q = b + std::copysign(std::sqrt(discriminant), b);
-  t0 = c / q;
-  t1 = q / a;
-  if (t0 > t1) std::swap(t0, t1);
-  return true;
 }
 
 // Roots of the infinite cylinder of radius r about the unit axis through the ray-relative point f;
@@ -290,59 +260,12 @@ Sphere Sphere::make(const Point3& center, double radius) {
   return Sphere{center, requirePositive("radius", radius)};
 }
 
-namespace {
-
-// The bodies of Sphere::intersect and Sphere::crossings, inlined there and into Primitive's path
-// for untransformed spheres and planes, the common primitives: no call through the variant
-// dispatch per candidate.
-[[gnu::always_inline]] inline bool sphereIntersect(const Sphere& sphere, const Ray& ray,
-                                                   double tMin, double tMax, ShapeHit& hit) {
-  const Point3& center = sphere.center;
-  const double radius = sphere.radius;
-  const Vec3 f = ray.origin - center;
-  if (wholeQuadricBehind(-dot(f, ray.direction), dot(f, f) - radius * radius, tMin)) return false;
-  double t0;
-  double t1;
-  if (!quadricRoots(f, ray.direction, radius, t0, t1)) return false;
-  double t;
-  if (inOpenRange(t0, tMin, tMax)) {
-    t = t0;
-  } else if (inOpenRange(t1, tMin, tMax)) {
-    t = t1;
-  } else {
-    return false;
-  }
-  hit.t = t;
-  const Vec3 rel = f + ray.direction * t;
-  hit.normal = Normal3(normalize(rel));
-  // Radial reprojection onto the sphere (error γ5·|rel|, pbrt-v4 §6.8.5); the re-intersection
-  // test |o − c|² − r² of a spawned origin o is exact to a few ulps of r² and r·|o − c|.
-  const Vec3 onSphere = rel * (radius / length(rel));
-  hit.point = center + onSphere;
-  hit.pointError = abs(onSphere) * gammaBound(8) + abs(toVec(hit.point)) * gammaBound(2);
-  return true;
-}
-
-[[gnu::always_inline]] inline int sphereCrossings(const Sphere& sphere, const Ray& ray, double tMin,
-                                                  double tMax) {
-  const Point3& center = sphere.center;
-  const double radius = sphere.radius;
-  const Vec3 f = ray.origin - center;
-  if (wholeQuadricBehind(-dot(f, ray.direction), dot(f, f) - radius * radius, tMin)) return 0;
-  double t0;
-  double t1;
-  if (!quadricRoots(f, ray.direction, radius, t0, t1)) return 0;
-  return int{inOpenRange(t0, tMin, tMax)} + int{inOpenRange(t1, tMin, tMax)};
-}
-
-}  // namespace
-
 bool Sphere::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
-  return sphereIntersect(*this, ray, tMin, tMax, hit);
+  return quadric::sphereIntersect(center, radius, ray, tMin, tMax, hit);
 }
 
 int Sphere::crossings(const Ray& ray, double tMin, double tMax) const {
-  return sphereCrossings(*this, ray, tMin, tMax);
+  return quadric::sphereCrossings(center, radius, ray, tMin, tMax);
 }
 
 Bounds3 Sphere::bounds() const {
@@ -983,7 +906,7 @@ Primitive::Primitive(Shape shape, std::uint32_t materialIndex, const Color& emis
 bool Primitive::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {
   if (!worldFromObject_) {
     if (const auto* sphere = std::get_if<Sphere>(&shape_))
-      return sphereIntersect(*sphere, ray, tMin, tMax, hit);
+      return quadric::sphereIntersect(sphere->center, sphere->radius, ray, tMin, tMax, hit);
     if (const auto* plane = std::get_if<Plane>(&shape_))
       return planeIntersect(*plane, ray, tMin, tMax, hit);
     return std::visit([&](const auto& s) { return s.intersect(ray, tMin, tMax, hit); }, shape_);
@@ -1018,7 +941,7 @@ int Primitive::crossings(const Ray& ray, double tMin, double tMax) const {
   // Untransformed (the common case): the shape reads the caller's ray, no copy.
   if (!worldFromObject_) {
     if (const auto* sphere = std::get_if<Sphere>(&shape_))
-      return sphereCrossings(*sphere, ray, tMin, tMax);
+      return quadric::sphereCrossings(sphere->center, sphere->radius, ray, tMin, tMax);
     if (const auto* plane = std::get_if<Plane>(&shape_))
       return planeCrossings(*plane, ray, tMin, tMax);
     return std::visit([&](const auto& s) { return s.crossings(ray, tMin, tMax); }, shape_);
