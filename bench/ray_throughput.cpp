@@ -47,10 +47,12 @@ struct Row {
   std::size_t rayCount;
   std::vector<Timing> glint;  // one per column measured, in the order of `columns`
   Timing embree1, embree16;
+  Timing glint16;  // closest hits in 16-ray packets (Aggregate::intersectPacket), widest column
   std::vector<Timing> embreeIsas;  // single rays on each --embree-isas device, in that order
   double agreement = 0;            // fraction of rays where glint and Embree give the same answer
   double hitFraction = 0;          // of glint's answers: hit / occluded
   bool isasAgree = true;           // every column gave the same answers, bit for bit
+  bool packetsAgree = true;        // glint's packets gave its single rays' answers, bit for bit
   const Timing& widest() const { return glint.back(); }
 };
 
@@ -84,7 +86,7 @@ Row measure(const std::string& sceneName, const RaySet& set, const std::vector<F
             Aggregates& aggregates, const std::vector<Column>& columns, RTCScene embree,
             const std::vector<RTCScene>& embreeIsas, Query query, int threads, int runs,
             bool packets) {
-  Row row{sceneName, set.name, query, threads, set.rays.size(), {}, {}, {}, {}, 0, 0, true};
+  Row row{sceneName, set.name, query, threads, set.rays.size(), {}, {}, {}, {}, {}, 0, 0, true};
   row.glint.resize(columns.size());
   row.embreeIsas.resize(embreeIsas.size());
   Aggregate* aggregate = nullptr;  // the column being run
@@ -112,6 +114,26 @@ Row measure(const std::string& sceneName, const RaySet& set, const std::vector<F
         }
       });
     }
+    return watch.seconds();
+  };
+  // Consecutive rays in packets of 16, as Embree's packets take them (camera rays: 16 pixels of a
+  // row).
+  const auto runGlintPackets = [&] {
+    const Stopwatch watch;
+    forBlocks(arena, n, [&](std::size_t b, std::size_t e) {
+      std::array<Hit, Aggregate::kPacketSize> hits;
+      std::array<bool, Aggregate::kPacketSize> found{};
+      std::array<double, Aggregate::kPacketSize> tMax;
+      tMax.fill(kInfinity);
+      for (std::size_t i = b; i < e; i += Aggregate::kPacketSize) {
+        const auto count = static_cast<int>(std::min<std::size_t>(Aggregate::kPacketSize, e - i));
+        aggregate->intersectPacket(rays + i, count, 0, tMax.data(), hits.data(), found.data());
+        for (int k = 0; k < count; ++k) {
+          const auto lane = static_cast<std::size_t>(k);
+          tGlint[i + lane] = found[lane] ? hits[lane].t : kInfinity;
+        }
+      }
+    });
     return watch.seconds();
   };
   const auto runEmbreeOn = [&](RTCScene target, bool packet) {
@@ -150,6 +172,12 @@ Row measure(const std::string& sceneName, const RaySet& set, const std::vector<F
       row.isasAgree = row.isasAgree && firstT == tGlint && firstOcc == occGlint;
     }
   }
+  const bool glintPackets = packets && query == Query::Closest;
+  if (glintPackets) {
+    select(columns.back());
+    runGlintPackets();
+    row.packetsAgree = firstT == tGlint;
+  }
   for (const RTCScene other : embreeIsas) runEmbreeOn(other, false);
   runEmbree(false);
   if (packets) runEmbree(true);
@@ -157,6 +185,10 @@ Row measure(const std::string& sceneName, const RaySet& set, const std::vector<F
     for (std::size_t k = 0; k < columns.size(); ++k) {
       select(columns[k]);
       row.glint[k].seconds.push_back(runGlint());
+    }
+    if (glintPackets) {
+      select(columns.back());
+      row.glint16.seconds.push_back(runGlintPackets());
     }
     for (std::size_t k = 0; k < embreeIsas.size(); ++k) {
       row.embreeIsas[k].seconds.push_back(runEmbreeOn(embreeIsas[k], false));
@@ -215,8 +247,9 @@ void printRowHeader(bool packets, const std::vector<Column>& columns,
     const std::string ratio = columns.back().name() + "/Embree " + isa;
     std::printf(" %-20s | %15s |", title.c_str(), ratio.c_str());
   }
-  std::printf("%s %6s | %9s%s\n", packets ? " Embree-16 Mrays/s    |" : "", "hits", "agree",
-              columns.size() > 1 ? " | all same" : "");
+  std::printf("%s %6s | %9s%s\n",
+              packets ? " Embree-16 Mrays/s    | glint-16 Mrays/s     | g16/g1 | g16/E16 |" : "",
+              "hits", "agree", columns.size() > 1 ? " | all same" : "");
 }
 
 void printRow(const Row& r, const std::vector<Column>& columns, bool packets) {
@@ -236,6 +269,14 @@ void printRow(const Row& r, const std::vector<Column>& columns, bool packets) {
   }
   if (packets) {
     std::printf(" %8.2f ±%5.1f%%     |", mrays(r.rayCount, r.embree16), r.embree16.spreadPercent());
+    if (r.glint16.seconds.empty()) {
+      std::printf(" %-20s | %6s | %7s |", "-", "-", "-");
+    } else {
+      std::printf(" %8.2f ±%5.1f%% %s   | %6.2f | %7.2f |", mrays(r.rayCount, r.glint16),
+                  r.glint16.spreadPercent(), r.packetsAgree ? " " : "!",
+                  mrays(r.rayCount, r.glint16) / mrays(r.rayCount, r.widest()),
+                  mrays(r.rayCount, r.glint16) / mrays(r.rayCount, r.embree16));
+    }
   }
   std::printf(" %5.1f%% | %8.4f%%%s\n", 100 * r.hitFraction, 100 * r.agreement,
               r.glint.size() > 1 ? (r.isasAgree ? " | yes" : " | NO") : "");
@@ -248,7 +289,8 @@ int run(int argc, char** argv) {
       "                      [--widths] [--embree-isas ISA,ISA...]\n"
       "  --runs N      repetitions per figure (median printed; default 5)\n"
       "  --quick       10k-triangle torus instead of 1M, 256x192 rays (smoke test)\n"
-      "  --no-packets  skip the informative Embree 16-ray packet column\n"
+      "  --no-packets  skip the 16-ray packet columns (Embree rtcIntersect16/rtcOccluded16, glint\n"
+      "                intersectPacket on closest hits)\n"
       "  --embree-isa ISA  run Embree's kernels for ISA (sse2, sse4.2, avx, avx2, avx512) instead\n"
       "                of the widest this CPU has\n"
       "  --isas        every glint ISA this CPU runs (baseline, avx2, avx512) side by side, not\n"
@@ -386,9 +428,16 @@ int run(int argc, char** argv) {
                 one.query == Query::Closest ? "closest" : "shadow", g, e);
   }
   bool isasAgree = true;
+  bool packetsAgree = true;
   for (const Row& r : rows) {
     worstRatio = std::min(worstRatio, mrays(r.rayCount, r.widest()) / mrays(r.rayCount, r.embree1));
     isasAgree = isasAgree && r.isasAgree;
+    packetsAgree = packetsAgree && r.packetsAgree;
+  }
+  if (packets) {
+    std::printf(
+        "\nglint's 16-ray packets gave its single rays' answers on every closest-hit row: %s\n",
+        packetsAgree ? "yes" : "NO");
   }
   if (columns.size() > 1) {
     std::printf("\nevery column gave the same answers on every row: %s\n",

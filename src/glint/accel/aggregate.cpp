@@ -1,10 +1,10 @@
-// The Aggregate: input validation, build references for primitives and mesh triangles, and the two
-// traversals of the 4- or 8-wide BVH (closest hit near-child-first, transmittance in slot order),
-// plus the brute-force loops they are measured and tested against.
+// The Aggregate: input validation, build references for primitives and mesh triangles, and the
+// traversals of the 4- or 8-wide BVH (closest hit near-child-first, for one ray or a packet;
+// transmittance in slot order), plus the brute-force loops they are measured and tested against.
 //
 // Compiled once per instruction set (core/isa.h): as itself for the baseline, and included by
 // aggregate_avx2.cpp and aggregate_avx512.cpp, which define GLINT_ISA_KERNEL (the ISA's suffix of
-// the two queries' names) and GLINT_AGGREGATE_KERNELS_ONLY (everything but the queries left out).
+// the queries' names) and GLINT_AGGREGATE_KERNELS_ONLY (everything but the queries left out).
 // The queries are [[gnu::flatten]] so that the inline functions they call are compiled into them
 // for their ISA, never shared with other files (see src/CMakeLists.txt).
 #include "glint/accel/aggregate.h"
@@ -39,6 +39,7 @@ namespace glint {
 
 namespace {
 
+using aggregate_detail::LeafSphere;
 using bvh::kEmpty;
 using bvh::kInner;
 using bvh::kPrimitiveKey;
@@ -50,6 +51,8 @@ using slab::floatBelow;
 using slab::intersectHalf;
 using slab::intersectNode;
 using slab::kFarScale;
+using slab::kSlabRows;
+using slab::SlabRows;
 using slab::StackEntry;
 
 // Marks a triangle reference that was left out (degenerate) before compaction; not a valid key.
@@ -515,56 +518,175 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
 
 #endif  // GLINT_AGGREGATE_KERNELS_ONLY
 
-[[gnu::flatten]] bool Aggregate::GLINT_ISA_KERNEL(intersect)(const Ray& ray, double tMin,
-                                                             double tMax, Hit& hit) const {
-  if (acceleration_ == Acceleration::BruteForce) return intersectBruteForce(ray, tMin, tMax, hit);
-  enum class Found { None, Primitive, Triangle } found = Found::None;
-  double closest = tMax;
+namespace {
+
+// What a closest-hit search reads of the Aggregate's leaves.
+struct LeafView {
+  const Primitive* primitives;
+  const std::uint32_t* leafRefs;
+  const LeafSphere* leafSpheres;
+  const TriangleMesh* meshes;
+};
+
+// One ray's closest-hit search: the best hit so far and the bounds it sets on the rest of the walk.
+// The single-ray query keeps one, the packet query one per ray; both run the same leaf tests, so
+// a ray finds the same hit either way.
+//
+// Exact ties in t. The answer is the hit of least (t, rank), whatever order the tree is walked in
+// (node width, ISA, near-child order, packet or single ray): an unbounded primitive (rank 0: the
+// loop over them keeps the first of equals) before a bounded primitive (by index) before a mesh
+// triangle (by mesh, then triangle in leaf order, the same numbering for every width). Elements
+// are tested against `limit`: tMax (exclusive) until the tree finds a hit, then the next double
+// above `closest`, so an element at exactly `closest` is seen and the ranks decide.
+struct ClosestHitSearch {
+  enum class Found { None, Primitive, Triangle };
+
+  const Ray* ray = nullptr;
+  double tMin = 0;
+  Found found = Found::None;
+  double closest = 0;
+  double limit = 0;
+  std::uint64_t bestRank = 0;
+  float closestF = 0;  // floatAbove(closest · kFarScale): the slab tests' far bound
   ShapeHit shapeHit;
-  ShapeHit primitiveHit;       // the closest primitive hit so far (valid when found == Primitive)
+  ShapeHit primitiveHit;  // the closest primitive hit so far (valid when found == Primitive)
+  bool primitiveHitComplete = true;
   std::uint32_t hitIndex = 0;  // primitive, or triangle within hitMesh
   std::uint32_t hitMesh = 0;
   WatertightHit triangleHit;
   Vec3 triangleNormal;  // of the closest triangle hit, unnormalised (see hitTriangle)
+  WatertightRay wray;   // set up at the first triangle leaf: analytic scenes never need it
+  bool wrayReady = false;
 
-  // Unbounded primitives first: they are typically ground planes and walls, and a hit there shrinks
-  // the interval the BVH has to search. A plane's hit point waits until it is known to be the
-  // closest hit: a third of the plane hits of the spheres scene lie behind a sphere.
-  bool primitiveHitComplete = true;
-  for (const std::uint32_t index : unbounded_) {
-    bool complete;
-    if (primitives_[index].intersectDeferred(ray, tMin, closest, shapeHit, complete)) {
-      closest = shapeHit.t;
-      primitiveHit = shapeHit;
-      primitiveHitComplete = complete;
-      hitIndex = index;
-      found = Found::Primitive;
+  // Unbounded primitives first: they are typically ground planes and walls, and a hit there
+  // shrinks the interval the BVH has to search. A plane's hit point waits until it is known to be
+  // the closest hit: a third of the plane hits of the spheres scene lie behind a sphere.
+  void start(const Ray& r, double tMinimum, double tMax, const Primitive* primitives,
+             const std::vector<std::uint32_t>& unbounded) {
+    ray = &r;
+    tMin = tMinimum;
+    closest = tMax;
+    for (const std::uint32_t index : unbounded) {
+      bool complete;
+      if (primitives[index].intersectDeferred(r, tMin, closest, shapeHit, complete)) {
+        closest = shapeHit.t;
+        primitiveHit = shapeHit;
+        primitiveHitComplete = complete;
+        hitIndex = index;
+        found = Found::Primitive;
+      }
     }
+    limit = closest;
+    closestF = floatAbove(closest * kFarScale);
   }
 
-  // Exact ties in t. The answer is the hit of least (t, rank), whatever order the tree is walked
-  // in (node width, ISA, near-child order): an unbounded primitive (rank 0: the loop above keeps
-  // the first of equals) before a bounded primitive (by index) before a mesh triangle (by mesh,
-  // then triangle in leaf order, the same numbering for every width). Elements are tested against
-  // `limit`: tMax (exclusive) until the tree finds a hit, then the next double above `closest`, so
-  // an element at exactly `closest` is seen and the ranks decide.
-  std::uint64_t bestRank = 0;
-  double limit = closest;
-  const auto accept = [&](double t, std::uint64_t rank) {
+  bool accept(double t, std::uint64_t rank) {
     if (t == closest && found != Found::None && !(rank < bestRank)) return false;
     closest = t;
     bestRank = rank;
     limit = nextUp(closest);
     return true;
-  };
+  }
+
+  // Tests the leaf (child, info) of the tree; true when it holds a closer hit (closestF lowered).
+  bool testLeaf(const LeafView& v, std::uint32_t child, std::uint32_t info) {
+    const std::uint32_t count = bvh::leafCount(info);
+    const std::uint32_t key = bvh::leafKey(info);
+    bool closer = false;
+    if (key == kPrimitiveKey) {
+      for (std::uint32_t k = child; k < child + count; ++k) {
+        const std::uint32_t index = v.leafRefs[k];
+        const LeafSphere& sphere = v.leafSpheres[k];
+        // An untransformed sphere inline, exactly as Primitive::intersect would test it.
+        const bool hitIt = sphere.radius > 0
+                               ? quadric::sphereIntersect(sphere.center, sphere.radius, *ray, tMin,
+                                                          limit, shapeHit)
+                               : v.primitives[index].intersect(*ray, tMin, limit, shapeHit);
+        if (hitIt && accept(shapeHit.t, kBoundedPrimitiveRank | index)) {
+          primitiveHit = shapeHit;
+          primitiveHitComplete = true;
+          hitIndex = index;
+          found = Found::Primitive;
+          closer = true;
+        }
+      }
+    } else {
+      const TriangleMesh& mesh = v.meshes[key];
+      if (!wrayReady) {
+        wray = WatertightRay(*ray);
+        wrayReady = true;
+      }
+      WatertightHit candidate;  // a rejected (parallel) candidate must not overwrite the best
+      Vec3 candidateNormal;
+      for (std::uint32_t triangle = child; triangle < child + count; ++triangle) {
+        if (hitTriangle(wray, ray->direction, verticesOf(mesh, triangle), tMin, limit, candidate,
+                        candidateNormal) &&
+            accept(candidate.t, triangleRank(key, triangle))) {
+          triangleHit = candidate;
+          triangleNormal = candidateNormal;
+          hitIndex = triangle;
+          hitMesh = key;
+          found = Found::Triangle;
+          closer = true;
+        }
+      }
+    }
+    if (closer) closestF = floatAbove(closest * kFarScale);
+    return closer;
+  }
+
+  // Fills hit from the best hit found (finishTriangle(mesh, triangle, watertight hit, normal, hit)
+  // for a triangle); false when there is none.
+  template <class FinishTriangle>
+  bool finish(const Primitive* primitives, Hit& hit, FinishTriangle finishTriangle) {
+    if (found == Found::Triangle) {
+      finishTriangle(hitMesh, hitIndex, triangleHit, triangleNormal, hit);
+    } else if (found == Found::Primitive) {
+      if (!primitiveHitComplete) primitives[hitIndex].completeHit(*ray, primitiveHit);
+      hit.t = closest;
+      hit.normal = primitiveHit.normal;
+      hit.shadingNormal = primitiveHit.normal;
+      hit.point = primitiveHit.point;
+      hit.pointError = primitiveHit.pointError;
+      hit.primitive = hitIndex;
+      hit.mesh = kNoMesh;
+      hit.triangle = 0;
+      hit.part = primitiveHit.part;
+      hit.instance = kNoInstance;
+    }
+    return found != Found::None;
+  }
+};
+
+// Near child first: visits the nearest entry of `hits` (hitCount ≥ 2 entries, any order) next
+// and pushes the others onto the stack farthest first.
+template <int kWidth, class Entry, class Stack>
+void sortNearFirst(std::array<Entry, kWidth>& hits, int hitCount, Stack& stack, int& stackSize) {
+  for (int k = 1; k < hitCount; ++k) {
+    const Entry entry = hits[k];
+    int j = k;
+    while (j > 0 && hits[j - 1].tNear > entry.tNear) {
+      hits[j] = hits[j - 1];
+      --j;
+    }
+    hits[j] = entry;
+  }
+  for (int k = hitCount - 1; k > 0; --k) stack[stackSize++] = hits[k];
+}
+
+}  // namespace
+
+[[gnu::flatten]] bool Aggregate::GLINT_ISA_KERNEL(intersect)(const Ray& ray, double tMin,
+                                                             double tMax, Hit& hit) const {
+  if (acceleration_ == Acceleration::BruteForce) return intersectBruteForce(ray, tMin, tMax, hit);
+  ClosestHitSearch search;
+  search.start(ray, tMin, tMax, primitives_.data(), unbounded_);
+  const LeafView leaves{primitives_.data(), leafRefs_.data(), leafSpheres_.data(), meshes_.data()};
   const auto traverse = [&](const auto* nodes) {
     using NodeType = std::remove_cvref_t<decltype(*nodes)>;
     constexpr int kWidth = NodeType::kWidth;
     const BoxRay boxRay(ray);
-    WatertightRay wray;  // set up at the first triangle leaf: analytic scenes never need it
-    bool wrayReady = false;
-    float closestF = floatAbove(closest * kFarScale);
-    ChildTest<NodeType> childTest(boxRay, floatBelow(tMin), closestF);
+    ChildTest<NodeType> childTest(boxRay, floatBelow(tMin), search.closestF);
     constexpr int kStack = kWidth == 4 ? bvh::kStackSize : bvh::kWideStackSize;
     std::array<StackEntry, kStack> stack;
     int stackSize = 0;
@@ -583,75 +705,24 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
             info = node.info[first];
             continue;
           }
-          // Near child first: visit the nearest entry now, push the others farthest first.
           std::array<StackEntry, kWidth> hits;
           int hitCount = 0;
           hits[hitCount++] = {node.child[first], node.info[first], tNear[first]};
           while (mask != 0) {
             const int i = std::countr_zero(mask);
             mask &= mask - 1;
-            StackEntry entry{node.child[i], node.info[i], tNear[i]};
-            int k = hitCount++;
-            while (k > 0 && hits[k - 1].tNear > entry.tNear) {
-              hits[k] = hits[k - 1];
-              --k;
-            }
-            hits[k] = entry;
+            hits[hitCount++] = {node.child[i], node.info[i], tNear[i]};
           }
-          for (int k = hitCount - 1; k > 0; --k) stack[stackSize++] = hits[k];
+          sortNearFirst<kWidth>(hits, hitCount, stack, stackSize);
           child = hits[0].child;
           info = hits[0].info;
           continue;
         }
-      } else {
-        const std::uint32_t count = bvh::leafCount(info);
-        const std::uint32_t key = bvh::leafKey(info);
-        bool closer = false;
-        if (key == kPrimitiveKey) {
-          for (std::uint32_t k = child; k < child + count; ++k) {
-            const std::uint32_t index = leafRefs_[k];
-            const LeafSphere& sphere = leafSpheres_[k];
-            // An untransformed sphere inline, exactly as Primitive::intersect would test it.
-            const bool hitIt = sphere.radius > 0
-                                   ? quadric::sphereIntersect(sphere.center, sphere.radius, ray,
-                                                              tMin, limit, shapeHit)
-                                   : primitives_[index].intersect(ray, tMin, limit, shapeHit);
-            if (hitIt && accept(shapeHit.t, kBoundedPrimitiveRank | index)) {
-              primitiveHit = shapeHit;
-              primitiveHitComplete = true;
-              hitIndex = index;
-              found = Found::Primitive;
-              closer = true;
-            }
-          }
-        } else {
-          const TriangleMesh& mesh = meshes_[key];
-          if (!wrayReady) {
-            wray = WatertightRay(ray);
-            wrayReady = true;
-          }
-          WatertightHit candidate;  // a rejected (parallel) candidate must not overwrite the best
-          Vec3 candidateNormal;
-          for (std::uint32_t triangle = child; triangle < child + count; ++triangle) {
-            if (hitTriangle(wray, ray.direction, verticesOf(mesh, triangle), tMin, limit, candidate,
-                            candidateNormal) &&
-                accept(candidate.t, triangleRank(key, triangle))) {
-              triangleHit = candidate;
-              triangleNormal = candidateNormal;
-              hitIndex = triangle;
-              hitMesh = key;
-              found = Found::Triangle;
-              closer = true;
-            }
-          }
-        }
-        if (closer) {
-          closestF = floatAbove(closest * kFarScale);
-          childTest.setTMax(closestF);
-        }
+      } else if (search.testLeaf(leaves, child, info)) {
+        childTest.setTMax(search.closestF);
       }
       // Pop the next entry that can still hold something closer (or as close: a tie).
-      while (stackSize > 0 && stack[stackSize - 1].tNear > closestF) --stackSize;
+      while (stackSize > 0 && stack[stackSize - 1].tNear > search.closestF) --stackSize;
       if (stackSize == 0) break;
       --stackSize;
       child = stack[stackSize].child;
@@ -667,23 +738,226 @@ void Aggregate::finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle,
   }
 
   // Instances last, within the closest hit so far: a tie keeps this aggregate's own hit.
-  if (instances_ && instances_->intersect(ray, tMin, closest, hit)) return true;
-  if (found == Found::Triangle) {
-    finishTriangleHit(hitMesh, hitIndex, triangleHit, triangleNormal, hit);
-  } else if (found == Found::Primitive) {
-    if (!primitiveHitComplete) primitives_[hitIndex].completeHit(ray, primitiveHit);
-    hit.t = closest;
-    hit.normal = primitiveHit.normal;
-    hit.shadingNormal = primitiveHit.normal;
-    hit.point = primitiveHit.point;
-    hit.pointError = primitiveHit.pointError;
-    hit.primitive = hitIndex;
-    hit.mesh = kNoMesh;
-    hit.triangle = 0;
-    hit.part = primitiveHit.part;
-    hit.instance = kNoInstance;
+  if (instances_ && instances_->intersect(ray, tMin, search.closest, hit)) return true;
+  return search.finish(primitives_.data(), hit,
+                       [this](auto&&... args) { finishTriangleHit(args...); });
+}
+
+namespace {
+
+// The lanes of a packet of Aggregate::kPacketSize rays in this ISA's widest float registers: one
+// 512-bit register under AVX-512, two 256-bit ones under AVX2, four SSE ones in the baseline.
+// Lane for lane the arithmetic of the single-ray slab test (slab_test.h): subtract, multiply, then
+// max/min with the same operand order, so a NaN lane is ignored alike.
+constexpr int kPacketLanes = Aggregate::kPacketSize;
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+struct PacketChunk {
+  static constexpr int kWidth = 16;
+  __m512 v;
+  static PacketChunk load(const float* p) { return {_mm512_loadu_ps(p)}; }
+  static PacketChunk all(float x) { return {_mm512_set1_ps(x)}; }
+  friend PacketChunk operator-(PacketChunk a, PacketChunk b) { return {_mm512_sub_ps(a.v, b.v)}; }
+  friend PacketChunk operator*(PacketChunk a, PacketChunk b) { return {_mm512_mul_ps(a.v, b.v)}; }
+  friend PacketChunk max(PacketChunk a, PacketChunk b) { return {_mm512_max_ps(a.v, b.v)}; }
+  friend PacketChunk min(PacketChunk a, PacketChunk b) { return {_mm512_min_ps(a.v, b.v)}; }
+  friend unsigned lessEqual(PacketChunk a, PacketChunk b) {
+    return _mm512_cmp_ps_mask(a.v, b.v, _CMP_LE_OQ);
   }
-  return found != Found::None;
+  void store(float* p) const { _mm512_storeu_ps(p, v); }
+};
+#elif defined(__AVX2__)
+struct PacketChunk {
+  static constexpr int kWidth = 8;
+  __m256 v;
+  static PacketChunk load(const float* p) { return {_mm256_loadu_ps(p)}; }
+  static PacketChunk all(float x) { return {_mm256_set1_ps(x)}; }
+  friend PacketChunk operator-(PacketChunk a, PacketChunk b) { return {_mm256_sub_ps(a.v, b.v)}; }
+  friend PacketChunk operator*(PacketChunk a, PacketChunk b) { return {_mm256_mul_ps(a.v, b.v)}; }
+  friend PacketChunk max(PacketChunk a, PacketChunk b) { return {_mm256_max_ps(a.v, b.v)}; }
+  friend PacketChunk min(PacketChunk a, PacketChunk b) { return {_mm256_min_ps(a.v, b.v)}; }
+  friend unsigned lessEqual(PacketChunk a, PacketChunk b) {
+    return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)));
+  }
+  void store(float* p) const { _mm256_storeu_ps(p, v); }
+};
+#else
+struct PacketChunk {
+  static constexpr int kWidth = 4;
+  __m128 v;
+  static PacketChunk load(const float* p) { return {_mm_loadu_ps(p)}; }
+  static PacketChunk all(float x) { return {_mm_set1_ps(x)}; }
+  friend PacketChunk operator-(PacketChunk a, PacketChunk b) { return {_mm_sub_ps(a.v, b.v)}; }
+  friend PacketChunk operator*(PacketChunk a, PacketChunk b) { return {_mm_mul_ps(a.v, b.v)}; }
+  friend PacketChunk max(PacketChunk a, PacketChunk b) { return {_mm_max_ps(a.v, b.v)}; }
+  friend PacketChunk min(PacketChunk a, PacketChunk b) { return {_mm_min_ps(a.v, b.v)}; }
+  friend unsigned lessEqual(PacketChunk a, PacketChunk b) {
+    return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(a.v, b.v)));
+  }
+  void store(float* p) const { _mm_storeu_ps(p, v); }
+};
+#endif
+constexpr int kPacketChunks = kPacketLanes / PacketChunk::kWidth;
+
+// The slab-test data of a packet's rays (BoxRay's, one lane per ray), structure of arrays.
+struct PacketRays {
+  alignas(64) float nearOrigin[3][kPacketLanes];
+  alignas(64) float farOrigin[3][kPacketLanes];
+  alignas(64) float nearInverse[3][kPacketLanes];
+  alignas(64) float farInverse[3][kPacketLanes];
+  alignas(64) float tMin[kPacketLanes];
+  alignas(64) float tMax[kPacketLanes];  // each ray's closestF, lowered as it finds hits
+  SlabRows rows;                         // of Node, shared: one direction octant per packet
+};
+
+// Bit i: lane i's ray overlaps child `slot`'s box of `node` within its [tMin, tMax]; tNear
+// receives the entry distances.
+inline unsigned testPacketChild(const Node& node, int slot, const PacketRays& r, float* tNear) {
+  const auto row = [&](std::size_t offset) {
+    return reinterpret_cast<const float*>(reinterpret_cast<const unsigned char*>(node.bounds) +
+                                          offset)[slot];
+  };
+  std::array<float, 3> nearPlane;
+  std::array<float, 3> farPlane;
+  for (int axis = 0; axis < 3; ++axis) {
+    nearPlane[axis] = row(r.rows.nearRow[axis]);
+    farPlane[axis] = row(r.rows.farRow[axis]);
+  }
+  unsigned bits = 0;
+  for (int c = 0; c < kPacketChunks; ++c) {
+    const int lane = c * PacketChunk::kWidth;
+    PacketChunk tn = PacketChunk::load(r.tMin + lane);
+    PacketChunk tf = PacketChunk::load(r.tMax + lane);
+    for (int axis = 0; axis < 3; ++axis) {
+      const PacketChunk n =
+          (PacketChunk::all(nearPlane[axis]) - PacketChunk::load(r.nearOrigin[axis] + lane)) *
+          PacketChunk::load(r.nearInverse[axis] + lane);
+      const PacketChunk f =
+          (PacketChunk::all(farPlane[axis]) - PacketChunk::load(r.farOrigin[axis] + lane)) *
+          PacketChunk::load(r.farInverse[axis] + lane);
+      tn = max(n, tn);
+      tf = min(f, tf);
+    }
+    tn.store(tNear + lane);
+    bits |= lessEqual(tn, tf) << lane;
+  }
+  return bits;
+}
+
+struct PacketEntry {
+  std::uint32_t child;
+  std::uint32_t info;
+  std::uint32_t rays;  // bit i: ray i of the packet goes on into this child
+  float tNear;         // the least entry distance among those rays
+};
+
+}  // namespace
+
+[[gnu::flatten]] void Aggregate::GLINT_ISA_KERNEL(intersectPacket)(const Ray* rays, int count,
+                                                                   double tMin, const double* tMax,
+                                                                   Hit* hits, bool* found) const {
+  count = std::clamp(count, 0, kPacketSize);
+  // Packets walk 4-wide trees only; the rest go one ray at a time.
+  if (count == 0 || acceleration_ == Acceleration::BruteForce || rootInfo_ != kInner ||
+      !wideNodes_.empty()) {
+    for (int i = 0; i < count; ++i) {
+      found[i] = GLINT_ISA_KERNEL(intersect)(rays[i], tMin, tMax[i], hits[i]);
+    }
+    return;
+  }
+  std::array<ClosestHitSearch, kPacketSize> search;
+  PacketRays packet;
+  const float tMinF = floatBelow(tMin);
+  std::uint32_t active = 0;
+  const std::uint32_t octant = static_cast<std::uint32_t>(std::signbit(rays[0].direction.x)) |
+                               static_cast<std::uint32_t>(std::signbit(rays[0].direction.y)) << 1 |
+                               static_cast<std::uint32_t>(std::signbit(rays[0].direction.z)) << 2;
+  for (int i = 0; i < kPacketSize; ++i) {
+    packet.tMin[i] = tMinF;
+    packet.tMax[i] = -std::numeric_limits<float>::infinity();  // lanes without a ray never hit
+    for (int axis = 0; axis < 3; ++axis) {
+      packet.nearOrigin[axis][i] = packet.farOrigin[axis][i] = 0;
+      packet.nearInverse[axis][i] = packet.farInverse[axis][i] = 0;
+    }
+  }
+  for (int i = 0; i < count; ++i) {
+    const BoxRay boxRay(rays[i]);
+    if (boxRay.rows.nearRow != kSlabRows[octant].nearRow) {  // another octant: alone
+      found[i] = GLINT_ISA_KERNEL(intersect)(rays[i], tMin, tMax[i], hits[i]);
+      continue;
+    }
+    search[i].start(rays[i], tMin, tMax[i], primitives_.data(), unbounded_);
+    packet.tMax[i] = search[i].closestF;
+    for (int axis = 0; axis < 3; ++axis) {
+      packet.nearOrigin[axis][i] = _mm_cvtss_f32(boxRay.nearOrigin[axis]);
+      packet.farOrigin[axis][i] = _mm_cvtss_f32(boxRay.farOrigin[axis]);
+      packet.nearInverse[axis][i] = _mm_cvtss_f32(boxRay.nearInverse[axis]);
+      packet.farInverse[axis][i] = _mm_cvtss_f32(boxRay.farInverse[axis]);
+    }
+    active |= 1u << i;
+  }
+  packet.rows = kSlabRows[octant];
+
+  const LeafView leaves{primitives_.data(), leafRefs_.data(), leafSpheres_.data(), meshes_.data()};
+  // Depth first, nearest child first (by its rays' least entry distance); each child goes on with
+  // the rays that overlap its box. Every ray meets every leaf that single-ray traversal would
+  // test for it (or more), and the leaf tests and the tie ranks are the single ray's, so the
+  // answers are the same.
+  std::array<PacketEntry, bvh::kStackSize> stack;
+  int stackSize = 0;
+  std::uint32_t child = rootChild_;
+  std::uint32_t info = rootInfo_;
+  std::uint32_t mask = active;
+  while (mask != 0) {
+    if (info == kInner) {
+      const Node& node = nodes_[child];
+      std::array<PacketEntry, 4> next;
+      int nextCount = 0;
+      for (int slot = 0; slot < 4 && node.info[slot] != kEmpty; ++slot) {
+        alignas(64) std::array<float, kPacketSize> tNear;
+        const std::uint32_t rayBits = testPacketChild(node, slot, packet, tNear.data()) & mask;
+        if (rayBits == 0) continue;
+        float least = std::numeric_limits<float>::infinity();
+        for (std::uint32_t bits = rayBits; bits != 0; bits &= bits - 1) {
+          least = std::min(least, tNear[static_cast<std::size_t>(std::countr_zero(bits))]);
+        }
+        next[nextCount++] = {node.child[slot], node.info[slot], rayBits, least};
+      }
+      if (nextCount > 0) {
+        if (nextCount > 1) sortNearFirst<4>(next, nextCount, stack, stackSize);
+        child = next[0].child;
+        info = next[0].info;
+        mask = next[0].rays;
+        continue;
+      }
+    } else {
+      for (std::uint32_t bits = mask; bits != 0; bits &= bits - 1) {
+        const auto i = static_cast<std::size_t>(std::countr_zero(bits));
+        if (search[i].testLeaf(leaves, child, info)) packet.tMax[i] = search[i].closestF;
+      }
+    }
+    // Pop the next entry that can still hold something closer for one of its rays.
+    mask = 0;
+    while (stackSize > 0 && mask == 0) {
+      const PacketEntry& entry = stack[--stackSize];
+      for (std::uint32_t bits = entry.rays; bits != 0; bits &= bits - 1) {
+        const int i = std::countr_zero(bits);
+        if (!(entry.tNear > packet.tMax[i])) mask |= 1u << i;
+      }
+      child = entry.child;
+      info = entry.info;
+    }
+  }
+
+  for (std::uint32_t bits = active; bits != 0; bits &= bits - 1) {
+    const auto i = static_cast<std::size_t>(std::countr_zero(bits));
+    // Instances last, within the closest hit so far: a tie keeps this aggregate's own hit.
+    if (instances_ && instances_->intersect(rays[i], tMin, search[i].closest, hits[i])) {
+      found[i] = true;
+      continue;
+    }
+    found[i] = search[i].finish(primitives_.data(), hits[i],
+                                [this](auto&&... args) { finishTriangleHit(args...); });
+  }
 }
 
 [[gnu::flatten]] Color Aggregate::GLINT_ISA_KERNEL(transmittance)(const Ray& ray, double tMin,

@@ -25,6 +25,15 @@ inline constexpr std::uint32_t kNoInstance = 0xffffffffu;
 
 class InstanceSet;  // instances.h: groups placed by transforms (a two-level BVH)
 
+namespace aggregate_detail {
+// An untransformed sphere of a BVH leaf, tested inline (geometry/sphere_intersection.h); radius 0
+// for any other primitive.
+struct LeafSphere {
+  Point3 center;
+  double radius = 0;
+};
+}  // namespace aggregate_detail
+
 struct Hit {
   double t = 0;           // ray parameter
   Normal3 normal;         // unit geometric world-space normal, as the shape defines it
@@ -89,6 +98,16 @@ class Aggregate {
   bool intersect(const Ray& ray, double tMin, double tMax, Hit& hit) const {
     return (this->*kernels_->intersect)(ray, tMin, tMax, hit);
   }
+  // The closest hits of up to kPacketSize rays traced together (a packet: coherent rays such as
+  // the camera rays of neighbouring pixels): found[i] and hits[i] are exactly what
+  // intersect(rays[i], tMin, tMax[i], hits[i]) returns and sets, bit for bit. The tree is walked
+  // once for the packet, each node's boxes tested against all its rays at once (SIMD across rays);
+  // rays of a direction octant other than the first ray's are traced alone.
+  static constexpr int kPacketSize = 16;
+  void intersectPacket(const Ray* rays, int count, double tMin, const double* tMax, Hit* hits,
+                       bool* found) const {
+    (this->*kernels_->intersectPacket)(rays, count, tMin, tMax, hits, found);
+  }
   // Product of kt over every surface crossing in (tMin, tMax), this aggregate's own (the ISA's
   // kernel) times its instances'; stops early once it is black.
   Color transmittance(const Ray& ray, double tMin, double tMax) const;
@@ -135,9 +154,16 @@ class Aggregate {
   Color transmittanceBaseline(const Ray& ray, double tMin, double tMax) const;
   Color transmittanceAvx2(const Ray& ray, double tMin, double tMax) const;
   Color transmittanceAvx512(const Ray& ray, double tMin, double tMax) const;
+  void intersectPacketBaseline(const Ray* rays, int count, double tMin, const double* tMax,
+                               Hit* hits, bool* found) const;
+  void intersectPacketAvx2(const Ray* rays, int count, double tMin, const double* tMax, Hit* hits,
+                           bool* found) const;
+  void intersectPacketAvx512(const Ray* rays, int count, double tMin, const double* tMax, Hit* hits,
+                             bool* found) const;
   struct Kernels {
     bool (Aggregate::*intersect)(const Ray&, double, double, Hit&) const;
     Color (Aggregate::*transmittance)(const Ray&, double, double) const;
+    void (Aggregate::*intersectPacket)(const Ray*, int, double, const double*, Hit*, bool*) const;
     Isa isa;
   };
   static const Kernels& kernelsFor(Isa isa);  // aggregate_isa.cpp
@@ -163,13 +189,8 @@ class Aggregate {
   std::vector<bvh::Node> nodes_;
   std::vector<bvh::Node8> wideNodes_;
   std::vector<std::uint32_t> leafRefs_;
-  // Bvh: per primitive slot of leafRefs_, the centre and radius of an untransformed sphere, which
-  // the queries test inline (geometry/sphere_intersection.h); radius 0 for any other primitive.
-  struct LeafSphere {
-    Point3 center;
-    double radius = 0;
-  };
-  std::vector<LeafSphere> leafSpheres_;
+  // Bvh: per primitive slot of leafRefs_, its sphere record (aggregate_detail::LeafSphere).
+  std::vector<aggregate_detail::LeafSphere> leafSpheres_;
   int nodeWidth_ = 0;
   std::uint32_t rootChild_ = 0;
   std::uint32_t rootInfo_ = bvh::kEmpty;

@@ -5,10 +5,11 @@ namespace glint {
 
 const Aggregate::Kernels& Aggregate::kernelsFor(Isa isa) {
   static const Kernels kBaseline{&Aggregate::intersectBaseline, &Aggregate::transmittanceBaseline,
-                                 Isa::Baseline};
-  static const Kernels kAvx2{&Aggregate::intersectAvx2, &Aggregate::transmittanceAvx2, Isa::Avx2};
+                                 &Aggregate::intersectPacketBaseline, Isa::Baseline};
+  static const Kernels kAvx2{&Aggregate::intersectAvx2, &Aggregate::transmittanceAvx2,
+                             &Aggregate::intersectPacketAvx2, Isa::Avx2};
   static const Kernels kAvx512{&Aggregate::intersectAvx512, &Aggregate::transmittanceAvx512,
-                               Isa::Avx512};
+                               &Aggregate::intersectPacketAvx512, Isa::Avx512};
   switch (isa) {
     case Isa::Avx2:
       return kAvx2;

@@ -1399,6 +1399,94 @@ TEST(AggregateMeshTest, ParallelBuildIsIndependentOfTheThreadCount) {
             64);
 }
 
+// Packets (Aggregate::intersectPacket): every ray of a packet gets exactly its single-ray answer.
+// Coherent packets (a 4×4 block of camera-like rays, aimed near a mesh vertex or a primitive's
+// box corner so that they straddle edges and silhouettes, with a mix of far bounds), incoherent
+// ones (the property queries in groups of 16: mixed octants, traced alone) and short ones.
+TEST(AggregatePacketTest, EveryRayOfAPacketGetsItsSingleRayAnswer) {
+  const IsaSupport here = isaSupportHere();
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    SCOPED_TRACE("scene seed " + std::to_string(seed));
+    const MeshScene s = randomMeshScene(seed);
+    Rng rng(seed + 90);
+    struct Packet {
+      std::vector<Ray> rays;
+      double tMin = 0;
+      std::vector<double> tMax;
+    };
+    std::vector<Packet> packets;
+    for (int p = 0; p < 150; ++p) {
+      Packet packet;
+      packet.tMin = p % 3 == 0 ? 1e-3 : 0;
+      const Point3 eye = toPoint(uniformDirection(rng) * 40);
+      Point3 target;
+      if (p % 2 == 0) {
+        target = meshTarget(rng, s.meshes[pickIndex(rng, s.meshes.size())]);
+      } else {
+        const Primitive& prim = s.analytic.prims[pickIndex(rng, s.analytic.prims.size())];
+        target = prim.isBounded() ? prim.bounds().centroid() : Point3{0, 0, 0};
+      }
+      const Vec3 forward = normalize(target - eye);
+      Vec3 right;
+      Vec3 up;
+      orthonormalBasis(forward, right, up);
+      const double spread = 0.002 + 0.03 * rng.uniform();  // radians between neighbours
+      const int count = p % 10 == 9 ? 1 + static_cast<int>(rng.uniform() * 15) : 16;
+      for (int i = 0; i < count; ++i) {
+        const double x = (i % 4 - 1.5) * spread;
+        const double y = (i / 4 - 1.5) * spread;
+        packet.rays.push_back({eye, forward + right * x + up * y});
+        packet.tMax.push_back(rng.uniform() < 0.2 ? 20 + 40 * rng.uniform() : kInfinity);
+      }
+      packets.push_back(packet);
+    }
+    const std::vector<Query> queries = meshQueries(s, 300 + seed, 480);
+    for (std::size_t q = 0; q + 16 <= queries.size(); q += 16) {
+      Packet packet;
+      for (std::size_t i = q; i < q + 16; ++i) {
+        packet.rays.push_back(queries[i].ray);
+        packet.tMax.push_back(queries[i].tMax);
+      }
+      packets.push_back(packet);
+    }
+    for (const auto& [isa, kind] :
+         {std::pair{Isa::Baseline, Acceleration::Bvh4}, std::pair{Isa::Avx2, Acceleration::Bvh4},
+          std::pair{Isa::Avx512, Acceleration::Bvh4}, std::pair{Isa::Avx512, Acceleration::Bvh8},
+          std::pair{Isa::Baseline, Acceleration::BruteForce}}) {
+      if (!here.runs(isa)) continue;
+      SCOPED_TRACE(std::string(isaName(isa)) + ", " + treeName(kind));
+      Aggregate aggregate = s.make(kind);
+      aggregate.setIsa(isa);
+      int mismatches = 0;
+      int hits = 0;
+      int rays = 0;
+      for (const Packet& packet : packets) {
+        const int count = static_cast<int>(packet.rays.size());
+        std::array<Hit, Aggregate::kPacketSize> packetHits;
+        std::array<bool, Aggregate::kPacketSize> packetFound{};
+        aggregate.intersectPacket(packet.rays.data(), count, packet.tMin, packet.tMax.data(),
+                                  packetHits.data(), packetFound.data());
+        for (int i = 0; i < count; ++i) {
+          Hit single;
+          const bool found =
+              aggregate.intersect(packet.rays[i], packet.tMin, packet.tMax[i], single);
+          const auto k = static_cast<std::size_t>(i);
+          const bool same =
+              found == packetFound[k] && (!found || (identicalHit(single, packetHits[k]) &&
+                                                     single.part == packetHits[k].part &&
+                                                     single.instance == packetHits[k].instance));
+          mismatches += same ? 0 : 1;
+          hits += found ? 1 : 0;
+          ++rays;
+        }
+      }
+      EXPECT_EQ(mismatches, 0) << "of " << rays << " rays";
+      EXPECT_GT(hits, rays / 3);
+      EXPECT_LT(hits, rays);
+    }
+  }
+}
+
 // Instruction sets (core/isa.h). ctest also runs every test of this file under GLINT_ISA=avx2 and
 // GLINT_ISA=avx512 (tests/CMakeLists.txt: aggregate_properties_*), where each Aggregate above
 // starts with that ISA's kernels; here one tree is queried with every ISA this processor runs.

@@ -454,6 +454,10 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
 // (0 for a camera ray), `weight` the product of kr/kt factors that scale this ray's contribution,
 // `split` whether the path has already fanned out into several glossy rays, `stream` its samples,
 // `differential` the ray's footprint (textured scenes only; else null).
+Color traceFound(const TraceContext& ctx, const Ray& ray, const MediumStack& here, int depth,
+                 const Color& weight, bool split, const SampleStream& stream,
+                 const RayDifferential* differential, bool found, const Hit& hit);
+
 Color trace(const TraceContext& ctx, const Ray& ray, const MediumStack& media, int depth,
             const Color& weight, bool split, const SampleStream& stream,
             const RayDifferential* differential) {
@@ -466,7 +470,15 @@ Color trace(const TraceContext& ctx, const Ray& ray, const MediumStack& media, i
   if (ctx.nested) inside.emplace(media);
   const bool found = ctx.nested ? ctx.scene.intersect(ray, kInfinity, hit, *inside)
                                 : ctx.scene.intersect(ray, kInfinity, hit);
-  const MediumStack& here = ctx.nested ? *inside : media;
+  return traceFound(ctx, ray, ctx.nested ? *inside : media, depth, weight, split, stream,
+                    differential, found, hit);
+}
+
+// trace() past its closest-hit query: what the ray sees, given whether it hit and where (`here`:
+// the media at the hit). The camera-ray packets of renderBlock come in here with their hits.
+Color traceFound(const TraceContext& ctx, const Ray& ray, const MediumStack& here, int depth,
+                 const Color& weight, bool split, const SampleStream& stream,
+                 const RayDifferential* differential, bool found, const Hit& hit) {
   if (!found) {
     // Fog measured along rays hides whatever lies at infinity.
     if (ctx.fog && ctx.scene.fog()->distance == FogDistance::Ray) {
@@ -1023,27 +1035,65 @@ struct PixelSamples {
 // (pixel, s, seed); non-finite samples count as black and are counted. `cancel` is polled before
 // every sample (one relaxed load beside a whole camera path), so a pixel of millions of rays still
 // stops within one sample; false when it did.
+// Where a pixel's camera rays come from: the pixel's sample stream and its two camera dimensions,
+// the same for every sample of the pixel.
+class PixelCamera {
+ public:
+  PixelCamera(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
+              std::uint64_t seed)
+      : camera_(&ctx.scene.camera()),
+        column_(column),
+        row_(row),
+        jitter_(plan.jitter),
+        lensed_(camera_->hasLens()),
+        // A render that draws no sample never reads the key: its hash is skipped.
+        pixel_(plan.drawsSamples ? SampleStream::forPixel(static_cast<std::uint32_t>(column),
+                                                          static_cast<std::uint32_t>(row), 0, seed)
+                                 : SampleStream()),
+        // Dimensions nobody reads are not drawn: the pixel offset of an unjittered sample (the
+        // pixel centre) and the lens point of a pinhole camera (generateRay ignores it).
+        offsets_(jitter_ ? pixel_.dimension(kPixelDimension) : SobolDimension2D(0)),
+        lens_(lensed_ ? pixel_.dimension(kLensDimension) : SobolDimension2D(0)) {}
+
+  SampleStream stream(std::uint32_t n) const { return SampleStream(pixel_.key(), n); }
+  Point2 offset(std::uint32_t n) const { return jitter_ ? offsets_.at(n) : Point2{0.5, 0.5}; }
+  Point2 lensPoint(std::uint32_t n) const { return lensed_ ? lens_.at(n) : Point2{0.5, 0.5}; }
+  // Sample n's camera ray.
+  Ray ray(std::uint32_t n) const {
+    return camera_->generateRay(column_, row_, offset(n), lensPoint(n));
+  }
+
+ private:
+  const Camera* camera_;
+  int column_;
+  int row_;
+  bool jitter_;
+  bool lensed_;
+  SampleStream pixel_;
+  SobolDimension2D offsets_;
+  SobolDimension2D lens_;
+};
+
+// Adds a sample's value to the pixel's sums; a non-finite one counts as black and is counted.
+void addSample(const SamplingPlan& plan, Color value, PixelSamples& samples) {
+  if (!isFinite(value)) {
+    value = Color{};
+    ++samples.nonFinite;
+  }
+  samples.sum += value;
+  if (plan.adaptive) samples.sumSquares += value * value;
+}
+
 bool addSamples(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
                 std::uint64_t seed, const std::atomic<bool>* cancel, PixelSamples& samples,
                 std::uint32_t target) {
   const Camera& camera = ctx.scene.camera();
-  // The key and the two camera dimensions are the same for every sample of the pixel. A render
-  // that draws no sample never reads the key: its hash is skipped.
-  const SampleStream pixel = plan.drawsSamples
-                                 ? SampleStream::forPixel(static_cast<std::uint32_t>(column),
-                                                          static_cast<std::uint32_t>(row), 0, seed)
-                                 : SampleStream();
-  // Dimensions nobody reads are not drawn: the pixel offset of an unjittered sample (the pixel
-  // centre) and the lens point of a pinhole camera (generateRay ignores it).
-  const bool lensed = camera.hasLens();
-  const SobolDimension2D offsets =
-      plan.jitter ? pixel.dimension(kPixelDimension) : SobolDimension2D(0);
-  const SobolDimension2D lens = lensed ? pixel.dimension(kLensDimension) : SobolDimension2D(0);
+  const PixelCamera pixel(ctx, plan, column, row, seed);
   for (std::uint32_t& n = samples.n; n < target; ++n) {
     if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return false;
-    const SampleStream stream(pixel.key(), n);
-    const Point2 offset = plan.jitter ? offsets.at(n) : Point2{0.5, 0.5};
-    const Point2 lensPoint = lensed ? lens.at(n) : Point2{0.5, 0.5};
+    const SampleStream stream = pixel.stream(n);
+    const Point2 offset = pixel.offset(n);
+    const Point2 lensPoint = pixel.lensPoint(n);
     const Ray ray = camera.generateRay(column, row, offset, lensPoint);
     Color value;
     if (ctx.textured) {
@@ -1056,12 +1106,63 @@ bool addSamples(const TraceContext& ctx, const SamplingPlan& plan, int column, i
     } else {
       value = traceCameraRay(ctx, ray, stream);
     }
-    if (!isFinite(value)) {
-      value = Color{};
-      ++samples.nonFinite;
+    addSample(plan, value, samples);
+  }
+  return true;
+}
+
+// Whether renderBlock may take the pixels of a tile: a fixed number of samples per pixel under the
+// Whitted integrator, in a scene without nested media (whose camera rays pass boundaries) or
+// textures (whose camera rays carry differentials).
+bool rendersInBlocks(const TraceContext& ctx, const SamplingPlan& plan) {
+  return !plan.adaptive && !ctx.path && !ctx.nested && !ctx.textured;
+}
+
+// The pixels [x0, x0 + width) × [y0, y0 + height) of a tile (at most 4 × 4), sample by sample:
+// the camera rays of one sample of all of them are traced as one packet
+// (Aggregate::intersectPacket) and each shaded from its hit. The same rays, hits, values and sums
+// as addSamples gives each pixel alone (a pixel's samples are added in the same order), so the
+// image does not change; the packet only walks the tree once for the block's coherent rays.
+// samples[(y − y0)·4 + (x − x0)] receives pixel (x, y)'s. False when cancelled (polled per
+// sample, as addSamples does).
+bool renderBlock(const TraceContext& ctx, const SamplingPlan& plan, int x0, int y0, int width,
+                 int height, std::uint64_t seed, const std::atomic<bool>* cancel,
+                 std::array<PixelSamples, Aggregate::kPacketSize>& samples) {
+  constexpr int kSide = 4;
+  static_assert(kSide * kSide == Aggregate::kPacketSize);
+  std::array<std::optional<PixelCamera>, Aggregate::kPacketSize> pixels;
+  std::array<std::size_t, Aggregate::kPacketSize> slotOf;  // lane → samples slot
+  int count = 0;
+  for (int y = y0; y < y0 + height; ++y) {
+    for (int x = x0; x < x0 + width; ++x) {
+      pixels[static_cast<std::size_t>(count)].emplace(ctx, plan, x, y, seed);
+      slotOf[static_cast<std::size_t>(count)] =
+          static_cast<std::size_t>((y - y0) * kSide + (x - x0));
+      ++count;
     }
-    samples.sum += value;
-    if (plan.adaptive) samples.sumSquares += value * value;
+  }
+  std::array<Ray, Aggregate::kPacketSize> rays;
+  std::array<double, Aggregate::kPacketSize> tMax;
+  tMax.fill(kInfinity);
+  std::array<Hit, Aggregate::kPacketSize> hits;
+  std::array<bool, Aggregate::kPacketSize> found{};
+  for (std::uint32_t n = 0; n < plan.initial; ++n) {
+    if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return false;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(count); ++k) {
+      // As traceCameraRay gives it to trace().
+      const Ray ray = pixels[k]->ray(n);
+      rays[k] = Ray{ray.origin, normalize(ray.direction)};
+    }
+    ctx.scene.aggregate().intersectPacket(rays.data(), count, 0, tMax.data(), hits.data(),
+                                          found.data());
+    for (std::size_t k = 0; k < static_cast<std::size_t>(count); ++k) {
+      ++ctx.counts.camera;
+      const Color value = traceFound(ctx, rays[k], ctx.scene.cameraMedia(), 0, Color(1), false,
+                                     pixels[k]->stream(n), nullptr, found[k], hits[k]);
+      PixelSamples& pixel = samples[slotOf[k]];
+      addSample(plan, value, pixel);
+      ++pixel.n;
+    }
   }
   return true;
 }
@@ -1305,7 +1406,39 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
         abandoned = true;
       }
     }
-    for (int row = y0; row < y1 && !abandoned; ++row) {
+    // A pixel's finished samples: its colour, and its count and non-finite samples for the tile.
+    const auto finished = [&](int column, int row, const PixelSamples& samples) {
+      film.at(column - region.x0, row - region.y0) = samples.sum / static_cast<double>(samples.n);
+      tileSamples += samples.n;
+      if (samples.nonFinite > 0 &&
+          (!tileFirstNonFinite || before(PixelCoord{column, row}, *tileFirstNonFinite))) {
+        tileFirstNonFinite = PixelCoord{column, row};
+      }
+      tileNonFinite += samples.nonFinite;
+    };
+    if (rendersInBlocks(ctx, plan)) {
+      // Blocks of 4 × 4 pixels, their camera rays traced as packets (renderBlock).
+      for (int row = y0; row < y1 && !abandoned; row += 4) {
+        for (int column = x0; column < x1; column += 4) {
+          const int width = std::min(4, x1 - column);
+          const int height = std::min(4, y1 - row);
+          std::array<PixelSamples, Aggregate::kPacketSize> block{};
+          // Another thread's stop, polled per block; the caller's cancel flag per sample.
+          if (cancelled.load(std::memory_order_relaxed) ||
+              !renderBlock(ctx, plan, column, row, width, height, seed, options.cancel, block)) {
+            cancelled.store(true);
+            abandoned = true;
+            break;
+          }
+          for (int y = 0; y < height; ++y) {
+            for (int x = 0; x < width; ++x) {
+              finished(column + x, row + y, block[static_cast<std::size_t>(y * 4 + x)]);
+            }
+          }
+        }
+      }
+    }
+    for (int row = y0; row < y1 && !abandoned && !rendersInBlocks(ctx, plan); ++row) {
       for (int column = x0; column < x1; ++column) {
         // Another thread's stop, polled per pixel; the caller's cancel flag is polled per sample
         // inside finishPixel.
@@ -1320,12 +1453,10 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
           abandoned = true;
           break;
         }
-        const std::uint64_t pixelNonFinite = samples.nonFinite;
         tileSamples += samples.n;
-        if (pixelNonFinite > 0 && tileNonFinite == 0) {
+        if (samples.nonFinite > 0 && tileNonFinite == 0)
           tileFirstNonFinite = PixelCoord{column, row};
-        }
-        tileNonFinite += pixelNonFinite;
+        tileNonFinite += samples.nonFinite;
       }
     }
     // The rays of an abandoned tile were traced and count; its pixels are dropped and it is not

@@ -8,12 +8,14 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <thread>
 #include <utility>
 #include <vector>
 
+#include "glint/core/isa.h"
 #include "glint/geometry/shape.h"
 #include "glint/render/render_test_support.h"
 #include "glint/scene/scene.h"
@@ -127,6 +129,56 @@ TEST(Renderer, OneSamplePerPixelGoesThroughThePixelCentre) {
       const Color expected = traceRay(scene, scene.camera().generateRay(column, row), rng);
       EXPECT_EQ(film.at(column, row), expected) << column << "," << row;
     }
+  }
+}
+
+// Without adaptive sampling, textures, nested media or the path integrator, render() traces the
+// camera rays of 4 × 4 pixel blocks as packets (Aggregate::intersectPacket): every pixel must
+// still be exactly its single camera ray's colour. A fan of triangles (a mesh), spheres in front
+// of it, a reflective floor and a light; an image of odd size in small tiles, so that blocks are
+// cut short at tile and image edges; on every instruction set this processor runs.
+TEST(Renderer, CameraRayPacketsRenderEveryPixelAsItsSingleRay) {
+  SceneParts parts = baseParts(37, 23);
+  Material shiny;
+  shiny.kd = Color(0.6, 0.5, 0.4);
+  shiny.ks = Color(0.3);
+  shiny.shininess = 30;
+  shiny.kr = Color(0.4);
+  const std::uint32_t material = addMaterial(parts, shiny);
+  TriangleMesh fan;
+  constexpr int kSpokes = 24;
+  fan.positions.push_back({0, 0, -6});
+  for (int i = 0; i <= kSpokes; ++i) {
+    const double a = 2 * std::numbers::pi * i / kSpokes;
+    fan.positions.push_back({2.5 * std::cos(a), 2.5 * std::sin(a), -7 - 0.3 * std::sin(3 * a)});
+  }
+  for (std::uint32_t i = 1; i <= kSpokes; ++i) fan.indices.insert(fan.indices.end(), {0, i, i + 1});
+  fan.materialIndex = material;
+  parts.meshes.push_back(fan);
+  for (int i = 0; i < 5; ++i) {
+    parts.primitives.emplace_back(Sphere::make({-1.6 + 0.8 * i, 0.3 * (i % 2), -4.5}, 0.35),
+                                  material, Color{});
+  }
+  parts.primitives.emplace_back(Plane::make({0, -1.2, 0}, {0, 1, 0}), material, Color{});
+  parts.lights.push_back(PointLight{{2, 3, 1}, Color(1.5, 1.5, 1.5), {}});
+  for (const Isa isa : {Isa::Baseline, Isa::Avx2, Isa::Avx512}) {
+    if (!isaSupportHere().runs(isa)) continue;
+    SCOPED_TRACE(isaName(isa));
+    SceneParts copy = parts;
+    copy.isa = isa;
+    const Scene scene(std::move(copy));
+    RenderOptions options;
+    options.tileSize = 7;
+    const Film film = render(scene, options);
+    int mismatches = 0;
+    for (int row = 0; row < 23; ++row) {
+      for (int column = 0; column < 37; ++column) {
+        Rng rng(0);
+        const Color expected = traceRay(scene, scene.camera().generateRay(column, row), rng);
+        mismatches += film.at(column, row) == expected ? 0 : 1;
+      }
+    }
+    EXPECT_EQ(mismatches, 0) << "of 37 × 23 pixels";
   }
 }
 
