@@ -219,6 +219,20 @@ class ChildTest<Node8> {
 };
 #endif
 
+// Fills hit with a hit on analytic primitive `primitive` of this aggregate at t (its ShapeHit).
+inline void setPrimitiveHit(const ShapeHit& shapeHit, double t, std::uint32_t primitive, Hit& hit) {
+  hit.t = t;
+  hit.normal = shapeHit.normal;
+  hit.shadingNormal = shapeHit.normal;
+  hit.point = shapeHit.point;
+  hit.pointError = shapeHit.pointError;
+  hit.primitive = primitive;
+  hit.mesh = kNoMesh;
+  hit.triangle = 0;
+  hit.part = shapeHit.part;
+  hit.instance = kNoInstance;
+}
+
 // Tie ranks of the closest-hit query (see intersect): bounded primitives by index, then triangles
 // by mesh and triangle.
 constexpr std::uint64_t kBoundedPrimitiveRank = std::uint64_t{1} << 62;
@@ -643,16 +657,7 @@ struct ClosestHitSearch {
       finishTriangle(hitMesh, hitIndex, triangleHit, triangleNormal, hit);
     } else if (found == Found::Primitive) {
       if (!primitiveHitComplete) primitives[hitIndex].completeHit(*ray, primitiveHit);
-      hit.t = closest;
-      hit.normal = primitiveHit.normal;
-      hit.shadingNormal = primitiveHit.normal;
-      hit.point = primitiveHit.point;
-      hit.pointError = primitiveHit.pointError;
-      hit.primitive = hitIndex;
-      hit.mesh = kNoMesh;
-      hit.triangle = 0;
-      hit.part = primitiveHit.part;
-      hit.instance = kNoInstance;
+      setPrimitiveHit(primitiveHit, closest, hitIndex, hit);
     }
     return found != Found::None;
   }
@@ -1066,16 +1071,7 @@ bool Aggregate::intersectBruteForce(const Ray& ray, double tMin, double tMax, Hi
   for (std::uint32_t i = 0; i < primitives_.size(); ++i) {
     if (primitives_[i].intersect(ray, tMin, closest, shapeHit)) {
       closest = shapeHit.t;
-      hit.t = closest;
-      hit.normal = shapeHit.normal;
-      hit.shadingNormal = shapeHit.normal;
-      hit.point = shapeHit.point;
-      hit.pointError = shapeHit.pointError;
-      hit.primitive = i;
-      hit.mesh = kNoMesh;
-      hit.triangle = 0;
-      hit.part = shapeHit.part;
-      hit.instance = kNoInstance;
+      setPrimitiveHit(shapeHit, closest, i, hit);
       found = true;
     }
   }

@@ -21,6 +21,7 @@ namespace glint {
 namespace {
 
 using quadric::inOpenRange;
+using quadric::nearerRootInRange;
 using quadric::quadricRoots;
 using quadric::wholeQuadricBehind;
 
@@ -559,13 +560,7 @@ bool Tube::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) co
   double t1;
   if (!tubeRoots(f, ray.direction, axis, radius, t0, t1)) return false;
   double t;
-  if (inOpenRange(t0, tMin, tMax)) {
-    t = t0;
-  } else if (inOpenRange(t1, tMin, tMax)) {
-    t = t1;
-  } else {
-    return false;
-  }
+  if (!nearerRootInRange(t0, t1, tMin, tMax, t)) return false;
   hit.t = t;
   hit.normal = radialNormal(f + ray.direction * t, axis);
   tubeHitPoint(origin, axis, radius, f + ray.direction * t, hit);

@@ -16,6 +16,19 @@ namespace glint::quadric {
 
 inline bool inOpenRange(double t, double tMin, double tMax) { return t > tMin && t < tMax; }
 
+// The nearer of the roots t0 ≤ t1 that lies in (tMin, tMax), into t; false when neither does.
+inline bool nearerRootInRange(double t0, double t1, double tMin, double tMax, double& t) {
+  if (inOpenRange(t0, tMin, tMax)) {
+    t = t0;
+    return true;
+  }
+  if (inOpenRange(t1, tMin, tMax)) {
+    t = t1;
+    return true;
+  }
+  return false;
+}
+
 // Whether the sphere (or the tube's cross-section) relative to the ray origin, f = origin − centre,
 // lies wholly behind the ray: the origin is outside or on it (|f|² − r² ≥ 0) and the ray does not
 // move toward the centre (−f·d ≤ 0, −0 included). quadricRoots returns then, in floating point as
@@ -60,13 +73,7 @@ inline bool wholeQuadricBehind(double b, double c, double tMin) {
   double t1;
   if (!quadricRoots(f, ray.direction, radius, t0, t1)) return false;
   double t;
-  if (inOpenRange(t0, tMin, tMax)) {
-    t = t0;
-  } else if (inOpenRange(t1, tMin, tMax)) {
-    t = t1;
-  } else {
-    return false;
-  }
+  if (!nearerRootInRange(t0, t1, tMin, tMax, t)) return false;
   hit.t = t;
   const Vec3 rel = f + ray.direction * t;
   hit.normal = Normal3(normalize(rel));
