@@ -608,21 +608,32 @@ int run(int argc, char** argv) {
     }
   }
 
-  // Target: whole render <= 0.5x Tachyon's time on both scenes at 2 threads.
+  // Issue 16's targets at 2 threads: the spheres in at most Tachyon's time, the torus in at most
+  // half of it.
   bool anyTarget = false, met = true;
-  double worst = 0;
+  double worstExcess = 0;  // the largest ratio / limit
+  std::string worstRow;
   for (auto& [key, times] : results) {
     if (key.threads != 2 || !times.count(Renderer::Glint) || !times.count(Renderer::Tachyon)) {
       continue;
     }
     anyTarget = true;
+    const double limit = key.scene.find("spheres") != std::string::npos ? 1.0 : 0.5;
     const double r = times[Renderer::Glint].median() / times[Renderer::Tachyon].median();
-    worst = std::max(worst, r);
-    met = met && r <= 0.5;
+    if (r / limit > worstExcess) {
+      worstExcess = r / limit;
+      char text[96];
+      std::snprintf(text, sizeof text, "%s at %d spp: %.2fx against <= %.1fx", key.scene.c_str(),
+                    key.samples, r, limit);
+      worstRow = text;
+    }
+    met = met && r <= limit;
   }
   if (anyTarget) {
-    std::printf("\ntarget: glint <= 0.5x Tachyon at 2 threads on both scenes: worst %.2fx -> %s\n",
-                worst, met ? "MET" : "NOT MET");
+    std::printf(
+        "\ntarget (issue 16): at 2 threads spheres <= 1.0x and torus <= 0.5x Tachyon: worst %s -> "
+        "%s\n",
+        worstRow.c_str(), met ? "MET" : "NOT MET");
   }
   std::printf("load average at the end: %s\n", loadAverage().c_str());
   return 0;
