@@ -1031,10 +1031,6 @@ struct PixelSamples {
   std::uint64_t nonFinite = 0;  // samples that were not finite (counted as black)
 };
 
-// Adds the pixel's samples n … target − 1 to `samples`. Sample s uses the sampler stream
-// (pixel, s, seed); non-finite samples count as black and are counted. `cancel` is polled before
-// every sample (one relaxed load beside a whole camera path), so a pixel of millions of rays still
-// stops within one sample; false when it did.
 // Where a pixel's camera rays come from: the pixel's sample stream and its two camera dimensions,
 // the same for every sample of the pixel.
 class PixelCamera {
@@ -1084,6 +1080,10 @@ void addSample(const SamplingPlan& plan, Color value, PixelSamples& samples) {
   if (plan.adaptive) samples.sumSquares += value * value;
 }
 
+// Adds the pixel's samples n … target − 1 to `samples`. Sample s uses the sampler stream
+// (pixel, s, seed); non-finite samples count as black and are counted. `cancel` is polled before
+// every sample (one relaxed load beside a whole camera path), so a pixel of millions of rays still
+// stops within one sample; false when it did.
 bool addSamples(const TraceContext& ctx, const SamplingPlan& plan, int column, int row,
                 std::uint64_t seed, const std::atomic<bool>* cancel, PixelSamples& samples,
                 std::uint32_t target) {
@@ -1092,11 +1092,11 @@ bool addSamples(const TraceContext& ctx, const SamplingPlan& plan, int column, i
   for (std::uint32_t& n = samples.n; n < target; ++n) {
     if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return false;
     const SampleStream stream = pixel.stream(n);
-    const Point2 offset = pixel.offset(n);
-    const Point2 lensPoint = pixel.lensPoint(n);
-    const Ray ray = camera.generateRay(column, row, offset, lensPoint);
+    const Ray ray = pixel.ray(n);
     Color value;
     if (ctx.textured) {
+      const Point2 offset = pixel.offset(n);
+      const Point2 lensPoint = pixel.lensPoint(n);
       // The rays through the same point of the pixels to the right and below, same lens point.
       const RayDifferential differential = cameraDifferential(
           ray, camera.generateRay(column, row, Point2{offset.x + 1, offset.y}, lensPoint),
@@ -1167,6 +1167,11 @@ bool renderBlock(const TraceContext& ctx, const SamplingPlan& plan, int x0, int 
   return true;
 }
 
+// The mean of a pixel's samples.
+Color pixelEstimate(const PixelSamples& samples) {
+  return samples.sum / static_cast<double>(samples.n);
+}
+
 // The estimate of one pixel: the mean of its samples. Without adaptive sampling, exactly
 // image.samples samples. Adaptive (image.adaptive): `initial` samples (already in `samples`),
 // then batches of `batch` more while the largest per-channel standard error of the pixel's mean
@@ -1194,7 +1199,7 @@ bool finishPixel(const TraceContext& ctx, const SamplingPlan& plan, int column, 
       }
     }
   }
-  color = samples.sum / static_cast<double>(samples.n);
+  color = pixelEstimate(samples);
   return true;
 }
 
@@ -1406,9 +1411,8 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
         abandoned = true;
       }
     }
-    // A pixel's finished samples: its colour, and its count and non-finite samples for the tile.
-    const auto finished = [&](int column, int row, const PixelSamples& samples) {
-      film.at(column - region.x0, row - region.y0) = samples.sum / static_cast<double>(samples.n);
+    // A finished pixel's samples and non-finite samples count for the tile.
+    const auto account = [&](int column, int row, const PixelSamples& samples) {
       tileSamples += samples.n;
       if (samples.nonFinite > 0 &&
           (!tileFirstNonFinite || before(PixelCoord{column, row}, *tileFirstNonFinite))) {
@@ -1430,33 +1434,34 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
             abandoned = true;
             break;
           }
-          for (int y = 0; y < height; ++y) {
-            for (int x = 0; x < width; ++x) {
-              finished(column + x, row + y, block[static_cast<std::size_t>(y * 4 + x)]);
+          for (int y = row; y < row + height; ++y) {
+            for (int x = column; x < column + width; ++x) {
+              const PixelSamples& samples =
+                  block[static_cast<std::size_t>((y - row) * 4 + (x - column))];
+              film.at(x - region.x0, y - region.y0) = pixelEstimate(samples);
+              account(x, y, samples);
             }
           }
         }
       }
-    }
-    for (int row = y0; row < y1 && !abandoned && !rendersInBlocks(ctx, plan); ++row) {
-      for (int column = x0; column < x1; ++column) {
-        // Another thread's stop, polled per pixel; the caller's cancel flag is polled per sample
-        // inside finishPixel.
-        PixelSamples own;
-        PixelSamples& samples = firstBatches ? firstBatches->at(column, row) : own;
-        const double neighbourError =
-            firstBatches ? firstBatches->neighbourError(column, row) : 0.0;
-        if (cancelled.load(std::memory_order_relaxed) ||
-            !finishPixel(ctx, plan, column, row, seed, options.cancel, samples, neighbourError,
-                         film.at(column - region.x0, row - region.y0))) {
-          cancelled.store(true);
-          abandoned = true;
-          break;
+    } else {
+      for (int row = y0; row < y1 && !abandoned; ++row) {
+        for (int column = x0; column < x1; ++column) {
+          // Another thread's stop, polled per pixel; the caller's cancel flag is polled per
+          // sample inside finishPixel.
+          PixelSamples own;
+          PixelSamples& samples = firstBatches ? firstBatches->at(column, row) : own;
+          const double neighbourError =
+              firstBatches ? firstBatches->neighbourError(column, row) : 0.0;
+          if (cancelled.load(std::memory_order_relaxed) ||
+              !finishPixel(ctx, plan, column, row, seed, options.cancel, samples, neighbourError,
+                           film.at(column - region.x0, row - region.y0))) {
+            cancelled.store(true);
+            abandoned = true;
+            break;
+          }
+          account(column, row, samples);
         }
-        tileSamples += samples.n;
-        if (samples.nonFinite > 0 && tileNonFinite == 0)
-          tileFirstNonFinite = PixelCoord{column, row};
-        tileNonFinite += samples.nonFinite;
       }
     }
     // The rays of an abandoned tile were traced and count; its pixels are dropped and it is not
