@@ -1,6 +1,6 @@
 # ctest isa_kernel_symbols: the objects compiled for AVX2 and AVX-512 (src/glint/accel/
-# aggregate_avx2.cpp, aggregate_avx512.cpp) must define no global code symbol but their three
-# queries: intersect, intersectPacket and transmittance (global data, such as inline constexpr
+# aggregate_avx2.cpp, aggregate_avx512.cpp) must define no global code symbol but their four
+# queries: intersect, intersectPacket, transmittance and transmittancePacket (global data, such as inline constexpr
 # tables, is allowed).
 # A weak copy of an inline function there (one that [[gnu::flatten]] did not inline) could be the
 # copy the linker keeps for the whole program, and crash it on a processor without that ISA.
@@ -25,17 +25,17 @@ foreach(object IN LISTS OBJECTS)
     if(line STREQUAL "")
       continue()
     endif()
-    if(line MATCHES " T _ZNK5glint9Aggregate[0-9]+(intersect|intersectPacket|transmittance)${suffix}E")
+    if(line MATCHES " T _ZNK5glint9Aggregate[0-9]+(intersect|intersectPacket|transmittance|transmittancePacket)${suffix}E")
       math(EXPR kernels "${kernels} + 1")
     elseif(line MATCHES "^[0-9a-f]+ [uVvRrDdBb] ")
       # Data, not code (an inline constexpr table such as slab_test.h's kSlabRows): the same bytes
       # whichever object the linker keeps, and no instruction of the ISA in it.
     else()
-      message(SEND_ERROR "${object}: a global symbol other than the three ${suffix} queries: ${line}")
+      message(SEND_ERROR "${object}: a global symbol other than the four ${suffix} queries: ${line}")
     endif()
   endforeach()
-  if(NOT kernels EQUAL 3)
-    message(SEND_ERROR "${object}: ${kernels} of the three ${suffix} queries defined")
+  if(NOT kernels EQUAL 4)
+    message(SEND_ERROR "${object}: ${kernels} of the four ${suffix} queries defined")
   endif()
   math(EXPR checked "${checked} + 1")
 endforeach()

@@ -1061,27 +1061,59 @@ struct PacketEntry {
   }
 }
 
+namespace {
+
+// Multiplies into `result` primitive `primitive`'s factor kt once per crossing of the ray within
+// (tMin, tMax) (a csg primitive: each crossing with its operand's kt); false once the product is
+// black. `sphere`: its leaf record (radius 0 when it is not an untransformed sphere, or unknown).
+// The one crossing rule of the single-ray and the packet transmittance queries.
+inline bool crossPrimitive(const Primitive& primitive, const Color& kt, const LeafSphere& sphere,
+                           const Ray& ray, double tMin, double tMax, Color& result) {
+  if (kt == Color(1)) return true;  // fully transparent: crossings cannot change the product
+  if (primitive.csg() != nullptr) {
+    result *= primitive.csgTransmittance(ray, tMin, tMax);
+    return !isBlack(result);
+  }
+  // An untransformed sphere inline, exactly as Primitive::crossings would count it.
+  const int crossings = sphere.radius > 0
+                            ? quadric::sphereCrossings(sphere.center, sphere.radius, ray, tMin, tMax)
+                            : primitive.crossings(ray, tMin, tMax);
+  if (crossings == 0) return true;
+  if (isBlack(kt)) return false;
+  for (int k = 0; k < crossings; ++k) result *= kt;
+  return !isBlack(result);
+}
+
+// Multiplies into `result` the mesh's factor kt once per triangle of the leaf range
+// [first, first + count) the ray crosses within (tMin, tMax); false once the product is black.
+// `wray` is set up at the first call (wrayReady).
+inline bool crossTriangles(const TriangleMesh& mesh, const Color& kt, std::uint32_t first,
+                           std::uint32_t count, const Ray& ray, double tMin, double tMax,
+                           WatertightRay& wray, bool& wrayReady, Color& result) {
+  if (kt == Color(1)) return true;
+  if (!wrayReady) {
+    wray = WatertightRay(ray);
+    wrayReady = true;
+  }
+  const bool opaque = isBlack(kt);
+  for (std::uint32_t triangle = first; triangle < first + count; ++triangle) {
+    if (!crossesTriangle(wray, ray.direction, verticesOf(mesh, triangle), tMin, tMax)) continue;
+    if (opaque) return false;
+    result *= kt;
+    if (isBlack(result)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 [[gnu::flatten]] Color Aggregate::GLINT_ISA_KERNEL(transmittance)(const Ray& ray, double tMin,
                                                                   double tMax) const {
   if (acceleration_ == Acceleration::BruteForce) return transmittanceBruteForce(ray, tMin, tMax);
   Color result(1);
-  // Multiplies in kt once per crossing of primitive `index`; false once the product is black.
-  // `sphere`: its leaf record (radius 0 when it is not an untransformed sphere, or unknown).
   const auto cross = [&](std::uint32_t index, const LeafSphere& sphere) {
-    const Color& kt = transmission_[index];
-    if (kt == Color(1)) return true;  // fully transparent: crossings cannot change the product
-    if (primitives_[index].csg() != nullptr) {  // each crossing with its operand's kt
-      result *= primitives_[index].csgTransmittance(ray, tMin, tMax);
-      return !isBlack(result);
-    }
-    // An untransformed sphere inline, exactly as Primitive::crossings would count it.
-    const int crossings =
-        sphere.radius > 0 ? quadric::sphereCrossings(sphere.center, sphere.radius, ray, tMin, tMax)
-                          : primitives_[index].crossings(ray, tMin, tMax);
-    if (crossings == 0) return true;
-    if (isBlack(kt)) return false;
-    for (int k = 0; k < crossings; ++k) result *= kt;
-    return !isBlack(result);
+    return crossPrimitive(primitives_[index], transmission_[index], sphere, ray, tMin, tMax,
+                          result);
   };
   for (const std::uint32_t index : unbounded_) {
     if (!cross(index, LeafSphere{})) return Color();
@@ -1131,21 +1163,9 @@ struct PacketEntry {
           for (std::uint32_t k = child; k < child + count; ++k) {
             if (!cross(leafRefs_[k], leafSpheres_[k])) return false;
           }
-        } else if (const Color& kt = meshTransmission_[key]; !(kt == Color(1))) {
-          const TriangleMesh& mesh = meshes_[key];
-          if (!wrayReady) {
-            wray = WatertightRay(ray);
-            wrayReady = true;
-          }
-          const bool opaque = isBlack(kt);
-          for (std::uint32_t triangle = child; triangle < child + count; ++triangle) {
-            if (!crossesTriangle(wray, ray.direction, verticesOf(mesh, triangle), tMin, tMax)) {
-              continue;
-            }
-            if (opaque) return false;
-            result *= kt;
-            if (isBlack(result)) return false;
-          }
+        } else if (!crossTriangles(meshes_[key], meshTransmission_[key], child, count, ray, tMin,
+                                   tMax, wray, wrayReady, result)) {
+          return false;
         }
       }
       if (stackSize == 0) break;
@@ -1157,6 +1177,135 @@ struct PacketEntry {
   };
   const bool open = wideNodes_.empty() ? traverse(nodes_.data()) : traverse(wideNodes_.data());
   return open ? result : Color();
+}
+
+// The packet form of the transmittance query: the tree walked once, depth first in slot order as
+// the single ray walks it, each child entered with the rays whose slab test (lane for lane the
+// single ray's arithmetic) overlaps its box. So each ray meets the leaves its single-ray walk
+// meets, in the same order, and multiplies the same kt factors in the same order: the same bits.
+// A ray whose product turns black leaves the packet (any-hit: an opaque blocker ends it).
+[[gnu::flatten]] void Aggregate::GLINT_ISA_KERNEL(transmittancePacket)(const Ray* rays, int count,
+                                                                       double tMin,
+                                                                       const double* tMax,
+                                                                       Color* results) const {
+  count = std::clamp(count, 0, kPacketSize);
+  // Packets walk 4-wide trees only; the rest go one ray at a time.
+  if (count == 0 || acceleration_ == Acceleration::BruteForce || rootInfo_ != kInner ||
+      !wideNodes_.empty()) {
+    for (int i = 0; i < count; ++i) {
+      results[i] = GLINT_ISA_KERNEL(transmittance)(rays[i], tMin, tMax[i]);
+    }
+    return;
+  }
+  PacketRays packet;
+  std::array<WatertightRay, kPacketSize> wrays;  // set up at each ray's first triangle leaf
+  std::array<bool, kPacketSize> wrayReady{};
+  const float tMinF = floatBelow(tMin);
+  std::uint32_t active = 0;
+  const std::uint32_t octant = static_cast<std::uint32_t>(std::signbit(rays[0].direction.x)) |
+                               static_cast<std::uint32_t>(std::signbit(rays[0].direction.y)) << 1 |
+                               static_cast<std::uint32_t>(std::signbit(rays[0].direction.z)) << 2;
+  for (int i = 0; i < kPacketSize; ++i) {
+    packet.tMin[i] = tMinF;
+    packet.tMax[i] = -std::numeric_limits<float>::infinity();  // lanes without a ray never hit
+    for (int axis = 0; axis < 3; ++axis) {
+      packet.nearOrigin[axis][i] = packet.farOrigin[axis][i] = 0;
+      packet.nearInverse[axis][i] = packet.farInverse[axis][i] = 0;
+    }
+  }
+  for (int i = 0; i < count; ++i) {
+    const BoxRay boxRay(rays[i]);
+    if (boxRay.rows.nearRow != kSlabRows[octant].nearRow) {  // another octant: alone
+      results[i] = GLINT_ISA_KERNEL(transmittance)(rays[i], tMin, tMax[i]);
+      continue;
+    }
+    results[i] = Color(1);
+    // Unbounded primitives first, as the single ray takes them.
+    bool open = true;
+    for (const std::uint32_t index : unbounded_) {
+      if (!crossPrimitive(primitives_[index], transmission_[index], LeafSphere{}, rays[i], tMin,
+                          tMax[i], results[i])) {
+        open = false;
+        break;
+      }
+    }
+    if (!open) {
+      results[i] = Color();
+      continue;
+    }
+    packet.tMax[i] = floatAbove(tMax[i] * kFarScale);
+    for (int axis = 0; axis < 3; ++axis) {
+      packet.nearOrigin[axis][i] = _mm_cvtss_f32(boxRay.nearOrigin[axis]);
+      packet.farOrigin[axis][i] = _mm_cvtss_f32(boxRay.farOrigin[axis]);
+      packet.nearInverse[axis][i] = _mm_cvtss_f32(boxRay.nearInverse[axis]);
+      packet.farInverse[axis][i] = _mm_cvtss_f32(boxRay.farInverse[axis]);
+    }
+    active |= 1u << i;
+  }
+  packet.rows = kSlabRows[octant];
+
+  // Ray i is blocked: black, and out of the packet.
+  const auto block = [&](std::size_t i) {
+    results[i] = Color();
+    active &= ~(1u << i);
+    packet.tMax[i] = -std::numeric_limits<float>::infinity();
+  };
+  struct Entry {
+    std::uint32_t child;
+    std::uint32_t info;
+    std::uint32_t rays;  // bit i: ray i of the packet goes on into this child
+  };
+  std::array<Entry, bvh::kStackSize> stack;
+  int stackSize = 0;
+  std::uint32_t child = rootChild_;
+  std::uint32_t info = rootInfo_;
+  std::uint32_t mask = active;
+  while (mask != 0) {
+    if (info == kInner) {
+      const Node& node = nodes_[child];
+      std::array<Entry, 4> next;
+      int nextCount = 0;
+      for (int slot = 0; slot < 4 && node.info[slot] != kEmpty; ++slot) {
+        alignas(64) std::array<float, kPacketSize> tNear;
+        const std::uint32_t rayBits = testPacketChild(node, slot, packet, tNear.data()) & mask;
+        if (rayBits != 0) next[nextCount++] = {node.child[slot], node.info[slot], rayBits};
+      }
+      if (nextCount > 0) {
+        // The others last slot first, so that they come off the stack in slot order.
+        for (int k = nextCount - 1; k > 0; --k) stack[stackSize++] = next[k];
+        child = next[0].child;
+        info = next[0].info;
+        mask = next[0].rays;
+        continue;
+      }
+    } else {
+      const std::uint32_t leafCount = bvh::leafCount(info);
+      const std::uint32_t key = bvh::leafKey(info);
+      for (std::uint32_t bits = mask; bits != 0; bits &= bits - 1) {
+        const auto i = static_cast<std::size_t>(std::countr_zero(bits));
+        bool open = true;
+        if (key == kPrimitiveKey) {
+          for (std::uint32_t k = child; k < child + leafCount && open; ++k) {
+            const std::uint32_t index = leafRefs_[k];
+            open = crossPrimitive(primitives_[index], transmission_[index], leafSpheres_[k],
+                                  rays[i], tMin, tMax[i], results[i]);
+          }
+        } else {
+          open = crossTriangles(meshes_[key], meshTransmission_[key], child, leafCount, rays[i],
+                                tMin, tMax[i], wrays[i], wrayReady[i], results[i]);
+        }
+        if (!open) block(i);
+      }
+    }
+    // Pop the next entry that one of the rays still open goes into.
+    mask = 0;
+    while (stackSize > 0 && mask == 0) {
+      const Entry& entry = stack[--stackSize];
+      mask = entry.rays & active;
+      child = entry.child;
+      info = entry.info;
+    }
+  }
 }
 
 #ifndef GLINT_AGGREGATE_KERNELS_ONLY
@@ -1237,6 +1386,15 @@ Color Aggregate::transmittance(const Ray& ray, double tMin, double tMax) const {
   Color result = (this->*kernels_->transmittance)(ray, tMin, tMax);
   if (instances_ && !isBlack(result)) result *= instances_->transmittance(ray, tMin, tMax);
   return result;
+}
+
+void Aggregate::transmittancePacket(const Ray* rays, int count, double tMin, const double* tMax,
+                                    Color* results) const {
+  (this->*kernels_->transmittancePacket)(rays, count, tMin, tMax, results);
+  if (!instances_) return;
+  for (int i = 0; i < std::clamp(count, 0, kPacketSize); ++i) {
+    if (!isBlack(results[i])) results[i] *= instances_->transmittance(rays[i], tMin, tMax[i]);
+  }
 }
 
 bool Aggregate::intersectInstances(const Ray& ray, double tMin, double tMax, Hit& hit) const {

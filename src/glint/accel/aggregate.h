@@ -111,6 +111,12 @@ class Aggregate {
   // Product of kt over every surface crossing in (tMin, tMax), this aggregate's own (the ISA's
   // kernel) times its instances'; stops early once it is black.
   Color transmittance(const Ray& ray, double tMin, double tMax) const;
+  // The transmittances of up to kPacketSize rays traced together (a packet: coherent rays such as
+  // the shadow rays of neighbouring camera hits toward one light): results[i] is exactly
+  // transmittance(rays[i], tMin, tMax[i]), bit for bit. As intersectPacket, the tree is walked
+  // once for the packet; rays of a direction octant other than the first ray's go alone.
+  void transmittancePacket(const Ray* rays, int count, double tMin, const double* tMax,
+                           Color* results) const;
 
   // The instruction set the two queries run with (core/isa.h); defaultIsa() when built, which
   // throws IsaError when GLINT_ISA is bad. setIsa throws IsaError when this processor cannot run
@@ -160,10 +166,17 @@ class Aggregate {
                            bool* found) const;
   void intersectPacketAvx512(const Ray* rays, int count, double tMin, const double* tMax, Hit* hits,
                              bool* found) const;
+  void transmittancePacketBaseline(const Ray* rays, int count, double tMin, const double* tMax,
+                                   Color* results) const;
+  void transmittancePacketAvx2(const Ray* rays, int count, double tMin, const double* tMax,
+                               Color* results) const;
+  void transmittancePacketAvx512(const Ray* rays, int count, double tMin, const double* tMax,
+                                 Color* results) const;
   struct Kernels {
     bool (Aggregate::*intersect)(const Ray&, double, double, Hit&) const;
     Color (Aggregate::*transmittance)(const Ray&, double, double) const;
     void (Aggregate::*intersectPacket)(const Ray*, int, double, const double*, Hit*, bool*) const;
+    void (Aggregate::*transmittancePacket)(const Ray*, int, double, const double*, Color*) const;
     Isa isa;
   };
   static const Kernels& kernelsFor(Isa isa);  // aggregate_isa.cpp

@@ -1,15 +1,18 @@
-// The Aggregate's choice of kernels: one pair of queries per instruction set (aggregate.cpp).
+// The Aggregate's choice of kernels: the queries of each instruction set (aggregate.cpp).
 #include "glint/accel/aggregate.h"
 
 namespace glint {
 
 const Aggregate::Kernels& Aggregate::kernelsFor(Isa isa) {
   static const Kernels kBaseline{&Aggregate::intersectBaseline, &Aggregate::transmittanceBaseline,
-                                 &Aggregate::intersectPacketBaseline, Isa::Baseline};
+                                 &Aggregate::intersectPacketBaseline,
+                                 &Aggregate::transmittancePacketBaseline, Isa::Baseline};
   static const Kernels kAvx2{&Aggregate::intersectAvx2, &Aggregate::transmittanceAvx2,
-                             &Aggregate::intersectPacketAvx2, Isa::Avx2};
+                             &Aggregate::intersectPacketAvx2,
+                             &Aggregate::transmittancePacketAvx2, Isa::Avx2};
   static const Kernels kAvx512{&Aggregate::intersectAvx512, &Aggregate::transmittanceAvx512,
-                               &Aggregate::intersectPacketAvx512, Isa::Avx512};
+                               &Aggregate::intersectPacketAvx512,
+                               &Aggregate::transmittancePacketAvx512, Isa::Avx512};
   switch (isa) {
     case Isa::Avx2:
       return kAvx2;

@@ -1399,11 +1399,13 @@ TEST(AggregateMeshTest, ParallelBuildIsIndependentOfTheThreadCount) {
             64);
 }
 
-// Packets (Aggregate::intersectPacket): every ray of a packet gets exactly its single-ray answer.
+// Packets (Aggregate::intersectPacket, transmittancePacket): every ray of a packet gets exactly
+// its single-ray answers.
 // Coherent packets (a 4×4 block of camera-like rays, aimed near a mesh vertex or a primitive's
 // box corner so that they straddle edges and silhouettes, with a mix of far bounds), incoherent
-// ones (the property queries in groups of 16: mixed octants, traced alone) and short ones.
-TEST(AggregatePacketTest, EveryRayOfAPacketGetsItsSingleRayAnswer) {
+// ones (the property queries in groups of 16: mixed octants, traced alone), short ones, and
+// shadow-ray packets converging on a light point.
+TEST(AggregatePacketTest, EveryRayOfAPacketGetsItsSingleRayAnswers) {
   const IsaSupport here = isaSupportHere();
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     SCOPED_TRACE("scene seed " + std::to_string(seed));
@@ -1440,6 +1442,26 @@ TEST(AggregatePacketTest, EveryRayOfAPacketGetsItsSingleRayAnswer) {
       }
       packets.push_back(packet);
     }
+    // Shadow-ray packets: from a 4 × 4 patch of points toward one light point, each ray ending
+    // there (tMax = its distance) or running on to infinity.
+    for (int p = 0; p < 100; ++p) {
+      Packet packet;
+      packet.tMin = p % 4 == 0 ? 1e-4 : 0;
+      const Point3 light = toPoint(uniformDirection(rng) * (10 + 30 * rng.uniform()));
+      const Point3 centre = p % 2 == 0 ? meshTarget(rng, s.meshes[pickIndex(rng, s.meshes.size())])
+                                       : toPoint(uniformDirection(rng) * 8 * rng.uniform());
+      Vec3 right;
+      Vec3 up;
+      orthonormalBasis(normalize(light - centre), right, up);
+      const double spacing = 0.01 + 0.3 * rng.uniform();
+      for (int i = 0; i < 16; ++i) {
+        const Point3 from = centre + right * ((i % 4 - 1.5) * spacing) + up * ((i / 4 - 1.5) * spacing);
+        const Vec3 toLight = light - from;
+        packet.rays.push_back({from, normalize(toLight)});
+        packet.tMax.push_back(p % 5 == 4 ? kInfinity : length(toLight));
+      }
+      packets.push_back(packet);
+    }
     const std::vector<Query> queries = meshQueries(s, 300 + seed, 480);
     for (std::size_t q = 0; q + 16 <= queries.size(); q += 16) {
       Packet packet;
@@ -1460,12 +1482,25 @@ TEST(AggregatePacketTest, EveryRayOfAPacketGetsItsSingleRayAnswer) {
       int mismatches = 0;
       int hits = 0;
       int rays = 0;
+      int transmittanceMismatches = 0;
+      int blocked = 0;
+      int dimmed = 0;  // neither black nor 1: crossings of partly transparent surfaces
       for (const Packet& packet : packets) {
         const int count = static_cast<int>(packet.rays.size());
         std::array<Hit, Aggregate::kPacketSize> packetHits;
         std::array<bool, Aggregate::kPacketSize> packetFound{};
         aggregate.intersectPacket(packet.rays.data(), count, packet.tMin, packet.tMax.data(),
                                   packetHits.data(), packetFound.data());
+        std::array<Color, Aggregate::kPacketSize> packetTransmittance;
+        aggregate.transmittancePacket(packet.rays.data(), count, packet.tMin, packet.tMax.data(),
+                                      packetTransmittance.data());
+        for (int i = 0; i < count; ++i) {
+          const Color single = aggregate.transmittance(packet.rays[i], packet.tMin, packet.tMax[i]);
+          const Color& fromPacket = packetTransmittance[static_cast<std::size_t>(i)];
+          transmittanceMismatches += std::memcmp(&single, &fromPacket, sizeof(Color)) == 0 ? 0 : 1;
+          blocked += isBlack(single) ? 1 : 0;
+          dimmed += !isBlack(single) && !(single == Color(1)) ? 1 : 0;
+        }
         for (int i = 0; i < count; ++i) {
           Hit single;
           const bool found =
@@ -1483,6 +1518,9 @@ TEST(AggregatePacketTest, EveryRayOfAPacketGetsItsSingleRayAnswer) {
       EXPECT_EQ(mismatches, 0) << "of " << rays << " rays";
       EXPECT_GT(hits, rays / 3);
       EXPECT_LT(hits, rays);
+      EXPECT_EQ(transmittanceMismatches, 0) << "of " << rays << " rays";
+      EXPECT_GT(blocked, rays / 200);
+      EXPECT_GT(dimmed, rays / 20);
     }
   }
 }

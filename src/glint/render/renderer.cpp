@@ -10,9 +10,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
+#include <memory>
 #include <mutex>
 #include <numbers>
 #include <optional>
@@ -140,6 +143,51 @@ class SpawnOrigins {
   bool ready_[2] = {false, false};
 };
 
+// Lights whose camera-hit shadow rays renderBlock traces as packets: the first ones of the scene
+// (point, spot and directional lights among them); the rest are traced one ray at a time.
+constexpr std::size_t kPacketLights = 8;
+// The light index shadeLightSample gets for a sample that is never traced ahead (area lights).
+constexpr std::size_t kUntracedLight = ~std::size_t{0};
+
+// The shadow rays of a packet of camera hits (renderBlock) toward each of the first kPacketLights
+// lights, traced ahead as one packet per light (Aggregate::transmittancePacket). Storage for a
+// tile's blocks, filled anew for each packet (traceCameraShadows).
+struct alignas(64) CameraShadows {
+  static constexpr std::size_t kLanes = Aggregate::kPacketSize;
+  static constexpr std::uint8_t kNone = 0xff;
+  struct LightPacket {
+    std::array<Ray, kLanes> rays;
+    std::array<double, kLanes> tMax;
+    std::array<Color, kLanes> transmittance;
+  };
+  std::array<LightPacket, kPacketLights> lights;
+  // [lane][light]: the index of lane's ray in lights[light], or kNone.
+  std::array<std::array<std::uint8_t, kPacketLights>, kLanes> rayOf;
+
+  // The transmittance traced ahead for lane's shadow ray toward `light`, when that ray is exactly
+  // `ray` with `tMax`; else null (the caller traces it).
+  const Color* find(std::size_t lane, std::size_t light, const Ray& ray, double tMax) const {
+    if (light >= kPacketLights) return nullptr;
+    const std::uint8_t r = rayOf[lane][light];
+    if (r == kNone) return nullptr;
+    const LightPacket& packet = lights[light];
+    if (!(packet.tMax[r] == tMax) || std::memcmp(&packet.rays[r], &ray, sizeof(Ray)) != 0) {
+      return nullptr;
+    }
+    return &packet.transmittance[r];
+  }
+};
+
+// The shadow ray and its tMax that shadeLightSample traces from the shading point of `origins`
+// toward a light sample of direction toPoint (−l: toward the light) at `lightPoint`, or toward
+// infinity when lightPoint is null.
+inline Ray lightShadowRay(SpawnOrigins& origins, const Vec3& toPoint, const Point3* lightPoint,
+                          double& tMax) {
+  const Ray shadowRay = origins.spawn(-toPoint);
+  tMax = lightPoint ? distance(shadowRay.origin, *lightPoint) : kInfinity;
+  return shadowRay;
+}
+
 // Shading inputs at one hit that every light sample shares (references into trace()'s frame: no
 // copies per hit).
 struct ShadingPoint {
@@ -153,6 +201,9 @@ struct ShadingPoint {
   SpawnOrigins& origins;  // of p, pError and n
   // The media on the viewer's side, where the shadow rays start (nested media only; else null).
   const MediumStack* media;
+  // A camera hit's shadow rays traced ahead (those of lane tracedLane), or null.
+  const CameraShadows* traced = nullptr;
+  std::size_t tracedLane = 0;
 };
 
 // One light sample's term of DESIGN.md §3:
@@ -160,20 +211,28 @@ struct ShadingPoint {
 // with its own shadow ray toward `lightPoint` (tMax = the distance to it, so nothing behind the
 // light, and never the light itself, blocks) or toward infinity when lightPoint is null.
 // Inlined: it runs once per light per hit, and an out-of-line call costs more than its shading.
+// `light`: the light's index, for a shadow ray traced ahead (sp.traced), or kUntracedLight.
 [[gnu::always_inline]] inline Color shadeLightSample(const TraceContext& ctx,
                                                      const ShadingPoint& sp,
                                                      const LightSample& sample,
-                                                     const Point3* lightPoint) {
+                                                     const Point3* lightPoint,
+                                                     std::size_t light = kUntracedLight) {
   const Vec3& l = sample.toPoint;
   const double nl = dot(sp.n, l);
   // The light and the eye must be on the same side of the surface.
   if (!(nl * sp.nv > 0)) return Color();
 
-  const Ray shadowRay = sp.origins.spawn(-l);
-  const double tMax = lightPoint ? distance(shadowRay.origin, *lightPoint) : kInfinity;
+  double tMax;
+  const Ray shadowRay = lightShadowRay(sp.origins, l, lightPoint, tMax);
   ++ctx.counts.shadow;
-  const Color transmittance = sp.media ? ctx.scene.transmittance(shadowRay, tMax, *sp.media)
-                                       : ctx.scene.transmittance(shadowRay, tMax);
+  Color transmittance;
+  if (const Color* ahead =
+          sp.traced != nullptr ? sp.traced->find(sp.tracedLane, light, shadowRay, tMax) : nullptr) {
+    transmittance = *ahead;
+  } else {
+    transmittance = sp.media ? ctx.scene.transmittance(shadowRay, tMax, *sp.media)
+                             : ctx.scene.transmittance(shadowRay, tMax);
+  }
   if (isBlack(transmittance)) return Color();
 
   const Material& material = sp.material;
@@ -264,7 +323,7 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
     if (const auto* point = std::get_if<PointLight>(&light)) {
       const LightSample sample = illuminate(*point, sp.p);
       if (isBlack(sample.intensity)) continue;
-      sum += shadeLightSample(ctx, sp, sample, &point->position);
+      sum += shadeLightSample(ctx, sp, sample, &point->position, i);
       continue;
     }
     if (const auto* area = std::get_if<AreaLight>(&light)) {
@@ -275,7 +334,8 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
     const LightSample sample = illuminate(light, sp.p);
     if (isBlack(sample.intensity)) continue;
     Point3 position;
-    sum += shadeLightSample(ctx, sp, sample, lightPosition(light, position) ? &position : nullptr);
+    sum += shadeLightSample(ctx, sp, sample, lightPosition(light, position) ? &position : nullptr,
+                            i);
   }
   return sum;
 }
@@ -361,7 +421,8 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
     const TraceContext& ctx, const Ray& ray, const Hit& hit, const MediumStack& media,
     const Material& material, const Color& emission, const Normal3& shadingNormal, int depth,
     const Color& weight, bool split, const SampleStream& stream, const TexturedHit* textured,
-    const RayDifferential* differential) {
+    const RayDifferential* differential, const CameraShadows* traced = nullptr,
+    std::size_t tracedLane = 0) {
   const int hitDepth = depth + 1;
   // The reprojected hit point and its error bound: ray.at(hit.t) would carry rounding error that
   // grows with the ray's origin and length, which no offset proportional to |p| covers.
@@ -383,9 +444,10 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
                  ? ambient
                  : ambient * ambientVisibility(ctx, origins, n, ns, nv, viewerMedia, stream, split);
   }
-  color += directLight(
-      ctx, ShadingPoint{material, p, n, ns, v, nv, !isBlack(material.ks), origins, viewerMedia},
-      stream, split);
+  color += directLight(ctx,
+                       ShadingPoint{material, p, n, ns, v, nv, !isBlack(material.ks), origins,
+                                    viewerMedia, traced, tracedLane},
+                       stream, split);
   if (hitDepth >= ctx.maxDepth) return color;
 
   const bool smooth = !(ns == n);
@@ -456,7 +518,8 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
 // `differential` the ray's footprint (textured scenes only; else null).
 Color traceFound(const TraceContext& ctx, const Ray& ray, const MediumStack& here, int depth,
                  const Color& weight, bool split, const SampleStream& stream,
-                 const RayDifferential* differential, bool found, const Hit& hit);
+                 const RayDifferential* differential, bool found, const Hit& hit,
+                 const CameraShadows* traced = nullptr, std::size_t tracedLane = 0);
 
 Color trace(const TraceContext& ctx, const Ray& ray, const MediumStack& media, int depth,
             const Color& weight, bool split, const SampleStream& stream,
@@ -475,10 +538,13 @@ Color trace(const TraceContext& ctx, const Ray& ray, const MediumStack& media, i
 }
 
 // trace() past its closest-hit query: what the ray sees, given whether it hit and where (`here`:
-// the media at the hit). The camera-ray packets of renderBlock come in here with their hits.
+// the media at the hit). The camera-ray packets of renderBlock come in here with their hits, and
+// with their shadow rays traced ahead (`traced`, lane tracedLane's; or null), which an untextured
+// hit without vertex colours takes.
 Color traceFound(const TraceContext& ctx, const Ray& ray, const MediumStack& here, int depth,
                  const Color& weight, bool split, const SampleStream& stream,
-                 const RayDifferential* differential, bool found, const Hit& hit) {
+                 const RayDifferential* differential, bool found, const Hit& hit,
+                 const CameraShadows* traced, std::size_t tracedLane) {
   if (!found) {
     // Fog measured along rays hides whatever lies at infinity.
     if (ctx.fog && ctx.scene.fog()->distance == FogDistance::Ray) {
@@ -494,7 +560,8 @@ Color traceFound(const TraceContext& ctx, const Ray& ray, const MediumStack& her
     color = traceVertexColouredHit(ctx, ray, hit, here, depth, weight, split, stream);
   } else {
     color = shadeHit(ctx, ray, hit, here, ctx.scene.materialOf(hit), ctx.scene.emissionOf(hit),
-                     hit.shadingNormal, depth, weight, split, stream, nullptr, nullptr);
+                     hit.shadingNormal, depth, weight, split, stream, nullptr, nullptr, traced,
+                     tracedLane);
   }
   return ctx.fog ? fogged(ctx, color, ray, hit.t, depth) : color;
 }
@@ -1118,16 +1185,70 @@ bool rendersInBlocks(const TraceContext& ctx, const SamplingPlan& plan) {
   return !plan.adaptive && !ctx.path && !ctx.nested && !ctx.textured;
 }
 
+// The shadow rays of a packet's camera hits toward each of the first kPacketLights lights that is
+// not an area light, traced as one packet per light (Aggregate::transmittancePacket) into
+// `shadows`: the rays shadeLightSample would trace at those hits (same side test, origin and
+// tMax). A hit whose material has nothing for a light to act on gets none. Whatever the shading
+// then asks for and finds there is the same ray with the same answer; anything else it traces
+// itself.
+void traceCameraShadows(const TraceContext& ctx, const Ray* rays, const Hit* hits,
+                        const bool* found, int count, CameraShadows& shadows) {
+  const std::vector<Light>& lights = ctx.scene.lights();
+  const std::size_t lightCount = std::min(lights.size(), kPacketLights);
+  std::array<std::optional<SpawnOrigins>, Aggregate::kPacketSize> origins;
+  std::array<double, Aggregate::kPacketSize> nv;
+  std::uint32_t lit = 0;  // bit k: lane k's hit takes light
+  for (int k = 0; k < count; ++k) {
+    const auto lane = static_cast<std::size_t>(k);
+    shadows.rayOf[lane].fill(CameraShadows::kNone);
+    if (!found[k]) continue;
+    const Hit& hit = hits[k];
+    // traceFound passes the rays on to the plain shading only.
+    if (ctx.vertexColors && hit.mesh != kNoMesh && !ctx.scene.meshOf(hit).colors.empty()) continue;
+    const Material& material = ctx.scene.materialOf(hit);
+    if (isBlack(material.kd) && isBlack(material.ks)) continue;
+    origins[lane].emplace(hit.point, hit.pointError, hit.normal);
+    nv[lane] = dot(hit.normal, rays[k].direction);
+    lit |= 1u << k;
+  }
+  if (lit == 0) return;
+  for (std::size_t i = 0; i < lightCount; ++i) {
+    const Light& light = lights[i];
+    if (std::holds_alternative<AreaLight>(light)) continue;
+    Point3 position;
+    const bool positioned = lightPosition(light, position);
+    CameraShadows::LightPacket& packet = shadows.lights[i];
+    int rayCount = 0;
+    for (std::uint32_t bits = lit; bits != 0; bits &= bits - 1) {
+      const auto lane = static_cast<std::size_t>(std::countr_zero(bits));
+      const Point3& p = hits[lane].point;
+      // As directLight samples the light and shadeLightSample tests the side.
+      const auto* point = std::get_if<PointLight>(&light);
+      const LightSample sample = point != nullptr ? illuminate(*point, p) : illuminate(light, p);
+      if (isBlack(sample.intensity) || !(dot(hits[lane].normal, sample.toPoint) * nv[lane] > 0)) {
+        continue;
+      }
+      const auto r = static_cast<std::size_t>(rayCount);
+      packet.rays[r] = lightShadowRay(*origins[lane], sample.toPoint,
+                                      positioned ? &position : nullptr, packet.tMax[r]);
+      shadows.rayOf[lane][i] = static_cast<std::uint8_t>(rayCount++);
+    }
+    ctx.scene.aggregate().transmittancePacket(packet.rays.data(), rayCount, 0, packet.tMax.data(),
+                                              packet.transmittance.data());
+  }
+}
+
 // The pixels [x0, x0 + width) × [y0, y0 + height) of a tile (at most 4 × 4), sample by sample:
 // the camera rays of one sample of all of them are traced as one packet
-// (Aggregate::intersectPacket) and each shaded from its hit. The same rays, hits, values and sums
-// as addSamples gives each pixel alone (a pixel's samples are added in the same order), so the
-// image does not change; the packet only walks the tree once for the block's coherent rays.
-// samples[(y − y0)·4 + (x − x0)] receives pixel (x, y)'s. False when cancelled (polled per
-// sample, as addSamples does).
+// (Aggregate::intersectPacket), their hits' shadow rays toward each light as one more
+// (traceCameraShadows), and each shaded from its hit. The same rays, hits, values and sums as
+// addSamples gives each pixel alone (a pixel's samples are added in the same order), so the
+// image does not change; the packets only walk the tree once for the block's coherent rays.
+// samples[(y − y0)·4 + (x − x0)] receives pixel (x, y)'s; `shadows` is scratch. False when
+// cancelled (polled per sample, as addSamples does).
 bool renderBlock(const TraceContext& ctx, const SamplingPlan& plan, int x0, int y0, int width,
                  int height, std::uint64_t seed, const std::atomic<bool>* cancel,
-                 std::array<PixelSamples, Aggregate::kPacketSize>& samples) {
+                 std::array<PixelSamples, Aggregate::kPacketSize>& samples, CameraShadows& shadows) {
   constexpr int kSide = 4;
   static_assert(kSide * kSide == Aggregate::kPacketSize);
   std::array<std::optional<PixelCamera>, Aggregate::kPacketSize> pixels;
@@ -1155,10 +1276,12 @@ bool renderBlock(const TraceContext& ctx, const SamplingPlan& plan, int x0, int 
     }
     ctx.scene.aggregate().intersectPacket(rays.data(), count, 0, tMax.data(), hits.data(),
                                           found.data());
+    traceCameraShadows(ctx, rays.data(), hits.data(), found.data(), count, shadows);
     for (std::size_t k = 0; k < static_cast<std::size_t>(count); ++k) {
       ++ctx.counts.camera;
-      const Color value = traceFound(ctx, rays[k], ctx.scene.cameraMedia(), 0, Color(1), false,
-                                     pixels[k]->stream(n), nullptr, found[k], hits[k]);
+      const Color value =
+          traceFound(ctx, rays[k], ctx.scene.cameraMedia(), 0, Color(1), false,
+                     pixels[k]->stream(n), nullptr, found[k], hits[k], &shadows, k);
       PixelSamples& pixel = samples[slotOf[k]];
       addSample(plan, value, pixel);
       ++pixel.n;
@@ -1421,7 +1544,9 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
       tileNonFinite += samples.nonFinite;
     };
     if (rendersInBlocks(ctx, plan)) {
-      // Blocks of 4 × 4 pixels, their camera rays traced as packets (renderBlock).
+      // Blocks of 4 × 4 pixels, their camera rays traced as packets (renderBlock). The shadow
+      // rays' scratch on cache lines of its own, as the hits are.
+      const auto shadows = std::make_unique<CameraShadows>();
       for (int row = y0; row < y1 && !abandoned; row += 4) {
         for (int column = x0; column < x1; column += 4) {
           const int width = std::min(4, x1 - column);
@@ -1429,7 +1554,8 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
           std::array<PixelSamples, Aggregate::kPacketSize> block{};
           // Another thread's stop, polled per block; the caller's cancel flag per sample.
           if (cancelled.load(std::memory_order_relaxed) ||
-              !renderBlock(ctx, plan, column, row, width, height, seed, options.cancel, block)) {
+              !renderBlock(ctx, plan, column, row, width, height, seed, options.cancel, block,
+                           *shadows)) {
             cancelled.store(true);
             abandoned = true;
             break;

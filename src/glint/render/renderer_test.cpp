@@ -135,8 +135,10 @@ TEST(Renderer, OneSamplePerPixelGoesThroughThePixelCentre) {
 // Without adaptive sampling, textures, nested media or the path integrator, render() traces the
 // camera rays of 4 × 4 pixel blocks as packets (Aggregate::intersectPacket): every pixel must
 // still be exactly its single camera ray's colour. A fan of triangles (a mesh), spheres in front
-// of it, a reflective floor and a light; an image of odd size in small tiles, so that blocks are
-// cut short at tile and image edges; on every instruction set this processor runs.
+// of it (some of glass), a reflective floor and lights of each kind (their shadow rays from the
+// camera hits go in packets too, Aggregate::transmittancePacket); an image of odd size in small
+// tiles, so that blocks are cut short at tile and image edges; on every instruction set this
+// processor runs.
 TEST(Renderer, CameraRayPacketsRenderEveryPixelAsItsSingleRay) {
   SceneParts parts = baseParts(37, 23);
   Material shiny;
@@ -155,12 +157,22 @@ TEST(Renderer, CameraRayPacketsRenderEveryPixelAsItsSingleRay) {
   for (std::uint32_t i = 1; i <= kSpokes; ++i) fan.indices.insert(fan.indices.end(), {0, i, i + 1});
   fan.materialIndex = material;
   parts.meshes.push_back(fan);
+  Material glass = shiny;  // dims the shadow rays through it (their packets multiply kt)
+  glass.kd = Color(0.1);
+  glass.kt = Color(0.5, 0.6, 0.7);
+  glass.ior = 1.3;
+  const std::uint32_t glassMaterial = addMaterial(parts, glass);
   for (int i = 0; i < 5; ++i) {
     parts.primitives.emplace_back(Sphere::make({-1.6 + 0.8 * i, 0.3 * (i % 2), -4.5}, 0.35),
-                                  material, Color{});
+                                  i % 2 == 0 ? material : glassMaterial, Color{});
   }
   parts.primitives.emplace_back(Plane::make({0, -1.2, 0}, {0, 1, 0}), material, Color{});
+  // Each kind of light whose camera-hit shadow rays go in packets (not area lights: traceRay
+  // below cannot draw a pixel's light samples).
   parts.lights.push_back(PointLight{{2, 3, 1}, Color(1.5, 1.5, 1.5), {}});
+  parts.lights.push_back(DirectionalLight{normalize(Vec3{-1, -2, -1}), Color(0.4)});
+  parts.lights.push_back(
+      SpotLight{{-2, 3, 0}, normalize(Vec3{0.5, -1, -1.5}), Color(2), {}, 1, 20, 40});
   for (const Isa isa : {Isa::Baseline, Isa::Avx2, Isa::Avx512}) {
     if (!isaSupportHere().runs(isa)) continue;
     SCOPED_TRACE(isaName(isa));
