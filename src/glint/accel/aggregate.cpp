@@ -850,6 +850,12 @@ namespace {
 // Lane for lane the arithmetic of the single-ray slab test (slab_test.h): subtract, multiply, then
 // max/min with the same operand order, so a NaN lane is ignored alike.
 constexpr int kPacketLanes = Aggregate::kPacketSize;
+// The least of four floats (none NaN).
+inline float minOfFour(__m128 x) {
+  x = _mm_min_ps(x, _mm_shuffle_ps(x, x, _MM_SHUFFLE(2, 3, 0, 1)));
+  x = _mm_min_ps(x, _mm_shuffle_ps(x, x, _MM_SHUFFLE(1, 0, 3, 2)));
+  return _mm_cvtss_f32(x);
+}
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
 struct PacketChunk {
   static constexpr int kWidth = 16;
@@ -862,6 +868,10 @@ struct PacketChunk {
   friend PacketChunk min(PacketChunk a, PacketChunk b) { return {_mm512_min_ps(a.v, b.v)}; }
   friend unsigned lessEqual(PacketChunk a, PacketChunk b) {
     return _mm512_cmp_ps_mask(a.v, b.v, _CMP_LE_OQ);
+  }
+  // The least of the lanes of `lanes` (bit i: lane i); +inf for none.
+  float minOf(unsigned lanes) const {
+    return _mm512_mask_reduce_min_ps(static_cast<__mmask16>(lanes), v);
   }
   void store(float* p) const { _mm512_storeu_ps(p, v); }
 };
@@ -878,6 +888,14 @@ struct PacketChunk {
   friend unsigned lessEqual(PacketChunk a, PacketChunk b) {
     return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)));
   }
+  float minOf(unsigned lanes) const {
+    const __m256i bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    const __m256 keep = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+        _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(lanes)), bit), bit));
+    const __m256 x =
+        _mm256_blendv_ps(_mm256_set1_ps(std::numeric_limits<float>::infinity()), v, keep);
+    return minOfFour(_mm_min_ps(_mm256_castps256_ps128(x), _mm256_extractf128_ps(x, 1)));
+  }
   void store(float* p) const { _mm256_storeu_ps(p, v); }
 };
 #else
@@ -893,6 +911,14 @@ struct PacketChunk {
   friend unsigned lessEqual(PacketChunk a, PacketChunk b) {
     return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(a.v, b.v)));
   }
+  float minOf(unsigned lanes) const {
+    const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
+    const __m128 keep = _mm_castsi128_ps(
+        _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<int>(lanes)), bit), bit));
+    return minOfFour(_mm_or_ps(
+        _mm_and_ps(keep, v),
+        _mm_andnot_ps(keep, _mm_set1_ps(std::numeric_limits<float>::infinity()))));
+  }
   void store(float* p) const { _mm_storeu_ps(p, v); }
 };
 #endif
@@ -907,11 +933,34 @@ struct PacketRays {
   alignas(64) float tMin[kPacketLanes];
   alignas(64) float tMax[kPacketLanes];  // each ray's closestF, lowered as it finds hits
   SlabRows rows;                         // of Node, shared: one direction octant per packet
+
+  // Every lane empty (its ray never overlaps a box), the packet's tMin set.
+  explicit PacketRays(double tMinimum) {
+    const float tMinF = floatBelow(tMinimum);
+    for (int i = 0; i < kPacketLanes; ++i) {
+      tMin[i] = tMinF;
+      tMax[i] = -std::numeric_limits<float>::infinity();
+      for (int axis = 0; axis < 3; ++axis) {
+        nearOrigin[axis][i] = farOrigin[axis][i] = nearInverse[axis][i] = farInverse[axis][i] = 0;
+      }
+    }
+  }
+  // Lane i takes the ray of boxRay with the far bound tMaxF.
+  void set(int i, const BoxRay& boxRay, float tMaxF) {
+    tMax[i] = tMaxF;
+    for (int axis = 0; axis < 3; ++axis) {
+      nearOrigin[axis][i] = _mm_cvtss_f32(boxRay.nearOrigin[axis]);
+      farOrigin[axis][i] = _mm_cvtss_f32(boxRay.farOrigin[axis]);
+      nearInverse[axis][i] = _mm_cvtss_f32(boxRay.nearInverse[axis]);
+      farInverse[axis][i] = _mm_cvtss_f32(boxRay.farInverse[axis]);
+    }
+  }
 };
 
-// Bit i: lane i's ray overlaps child `slot`'s box of `node` within its [tMin, tMax]; tNear
-// receives the entry distances.
-inline unsigned testPacketChild(const Node& node, int slot, const PacketRays& r, float* tNear) {
+// Bit i (of `lanes`): ray i overlaps child `slot`'s box of `node` within its [tMin, tMax].
+// `least` (when not null) receives the least entry distance of those rays (+inf for none).
+inline unsigned testPacketChild(const Node& node, int slot, const PacketRays& r, unsigned lanes,
+                                float* least) {
   const auto row = [&](std::size_t offset) {
     return reinterpret_cast<const float*>(reinterpret_cast<const unsigned char*>(node.bounds) +
                                           offset)[slot];
@@ -923,8 +972,12 @@ inline unsigned testPacketChild(const Node& node, int slot, const PacketRays& r,
     farPlane[axis] = row(r.rows.farRow[axis]);
   }
   unsigned bits = 0;
+  float nearest = std::numeric_limits<float>::infinity();
   for (int c = 0; c < kPacketChunks; ++c) {
     const int lane = c * PacketChunk::kWidth;
+    constexpr unsigned kChunkLanes = (1u << PacketChunk::kWidth) - 1;
+    const unsigned chunkLanes = (lanes >> lane) & kChunkLanes;
+    if (chunkLanes == 0) continue;
     PacketChunk tn = PacketChunk::load(r.tMin + lane);
     PacketChunk tf = PacketChunk::load(r.tMax + lane);
     for (int axis = 0; axis < 3; ++axis) {
@@ -937,9 +990,11 @@ inline unsigned testPacketChild(const Node& node, int slot, const PacketRays& r,
       tn = max(n, tn);
       tf = min(f, tf);
     }
-    tn.store(tNear + lane);
-    bits |= lessEqual(tn, tf) << lane;
+    const unsigned overlap = lessEqual(tn, tf) & chunkLanes;
+    if (least != nullptr && overlap != 0) nearest = std::min(nearest, tn.minOf(overlap));
+    bits |= overlap << lane;
   }
+  if (least != nullptr) *least = nearest;
   return bits;
 }
 
@@ -966,20 +1021,11 @@ struct PacketEntry {
   }
   std::array<ClosestHitSearch, kPacketSize> search;
   ShapeHit scratch;
-  PacketRays packet;
-  const float tMinF = floatBelow(tMin);
+  PacketRays packet(tMin);
   std::uint32_t active = 0;
   const std::uint32_t octant = static_cast<std::uint32_t>(std::signbit(rays[0].direction.x)) |
                                static_cast<std::uint32_t>(std::signbit(rays[0].direction.y)) << 1 |
                                static_cast<std::uint32_t>(std::signbit(rays[0].direction.z)) << 2;
-  for (int i = 0; i < kPacketSize; ++i) {
-    packet.tMin[i] = tMinF;
-    packet.tMax[i] = -std::numeric_limits<float>::infinity();  // lanes without a ray never hit
-    for (int axis = 0; axis < 3; ++axis) {
-      packet.nearOrigin[axis][i] = packet.farOrigin[axis][i] = 0;
-      packet.nearInverse[axis][i] = packet.farInverse[axis][i] = 0;
-    }
-  }
   for (int i = 0; i < count; ++i) {
     const BoxRay boxRay(rays[i]);
     if (boxRay.rows.nearRow != kSlabRows[octant].nearRow) {  // another octant: alone
@@ -987,13 +1033,7 @@ struct PacketEntry {
       continue;
     }
     search[i].start(rays[i], tMin, tMax[i], primitives_.data(), unbounded_, scratch);
-    packet.tMax[i] = search[i].closestF;
-    for (int axis = 0; axis < 3; ++axis) {
-      packet.nearOrigin[axis][i] = _mm_cvtss_f32(boxRay.nearOrigin[axis]);
-      packet.farOrigin[axis][i] = _mm_cvtss_f32(boxRay.farOrigin[axis]);
-      packet.nearInverse[axis][i] = _mm_cvtss_f32(boxRay.nearInverse[axis]);
-      packet.farInverse[axis][i] = _mm_cvtss_f32(boxRay.farInverse[axis]);
-    }
+    packet.set(i, boxRay, search[i].closestF);
     active |= 1u << i;
   }
   packet.rows = kSlabRows[octant];
@@ -1014,13 +1054,9 @@ struct PacketEntry {
       std::array<PacketEntry, 4> next;
       int nextCount = 0;
       for (int slot = 0; slot < 4 && node.info[slot] != kEmpty; ++slot) {
-        alignas(64) std::array<float, kPacketSize> tNear;
-        const std::uint32_t rayBits = testPacketChild(node, slot, packet, tNear.data()) & mask;
+        float least;
+        const std::uint32_t rayBits = testPacketChild(node, slot, packet, mask, &least);
         if (rayBits == 0) continue;
-        float least = std::numeric_limits<float>::infinity();
-        for (std::uint32_t bits = rayBits; bits != 0; bits &= bits - 1) {
-          least = std::min(least, tNear[static_cast<std::size_t>(std::countr_zero(bits))]);
-        }
         next[nextCount++] = {node.child[slot], node.info[slot], rayBits, least};
       }
       if (nextCount > 0) {
@@ -1197,22 +1233,13 @@ inline bool crossTriangles(const TriangleMesh& mesh, const Color& kt, std::uint3
     }
     return;
   }
-  PacketRays packet;
+  PacketRays packet(tMin);
   std::array<WatertightRay, kPacketSize> wrays;  // set up at each ray's first triangle leaf
   std::array<bool, kPacketSize> wrayReady{};
-  const float tMinF = floatBelow(tMin);
   std::uint32_t active = 0;
   const std::uint32_t octant = static_cast<std::uint32_t>(std::signbit(rays[0].direction.x)) |
                                static_cast<std::uint32_t>(std::signbit(rays[0].direction.y)) << 1 |
                                static_cast<std::uint32_t>(std::signbit(rays[0].direction.z)) << 2;
-  for (int i = 0; i < kPacketSize; ++i) {
-    packet.tMin[i] = tMinF;
-    packet.tMax[i] = -std::numeric_limits<float>::infinity();  // lanes without a ray never hit
-    for (int axis = 0; axis < 3; ++axis) {
-      packet.nearOrigin[axis][i] = packet.farOrigin[axis][i] = 0;
-      packet.nearInverse[axis][i] = packet.farInverse[axis][i] = 0;
-    }
-  }
   for (int i = 0; i < count; ++i) {
     const BoxRay boxRay(rays[i]);
     if (boxRay.rows.nearRow != kSlabRows[octant].nearRow) {  // another octant: alone
@@ -1233,13 +1260,7 @@ inline bool crossTriangles(const TriangleMesh& mesh, const Color& kt, std::uint3
       results[i] = Color();
       continue;
     }
-    packet.tMax[i] = floatAbove(tMax[i] * kFarScale);
-    for (int axis = 0; axis < 3; ++axis) {
-      packet.nearOrigin[axis][i] = _mm_cvtss_f32(boxRay.nearOrigin[axis]);
-      packet.farOrigin[axis][i] = _mm_cvtss_f32(boxRay.farOrigin[axis]);
-      packet.nearInverse[axis][i] = _mm_cvtss_f32(boxRay.nearInverse[axis]);
-      packet.farInverse[axis][i] = _mm_cvtss_f32(boxRay.farInverse[axis]);
-    }
+    packet.set(i, boxRay, floatAbove(tMax[i] * kFarScale));
     active |= 1u << i;
   }
   packet.rows = kSlabRows[octant];
@@ -1266,8 +1287,7 @@ inline bool crossTriangles(const TriangleMesh& mesh, const Color& kt, std::uint3
       std::array<Entry, 4> next;
       int nextCount = 0;
       for (int slot = 0; slot < 4 && node.info[slot] != kEmpty; ++slot) {
-        alignas(64) std::array<float, kPacketSize> tNear;
-        const std::uint32_t rayBits = testPacketChild(node, slot, packet, tNear.data()) & mask;
+        const std::uint32_t rayBits = testPacketChild(node, slot, packet, mask, nullptr);
         if (rayBits != 0) next[nextCount++] = {node.child[slot], node.info[slot], rayBits};
       }
       if (nextCount > 0) {

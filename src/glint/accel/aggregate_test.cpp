@@ -1403,8 +1403,9 @@ TEST(AggregateMeshTest, ParallelBuildIsIndependentOfTheThreadCount) {
 // its single-ray answers.
 // Coherent packets (a 4×4 block of camera-like rays, aimed near a mesh vertex or a primitive's
 // box corner so that they straddle edges and silhouettes, with a mix of far bounds), incoherent
-// ones (the property queries in groups of 16: mixed octants, traced alone), short ones, and
-// shadow-ray packets converging on a light point.
+// ones (the property queries in groups of 16: mixed octants, traced alone), short ones,
+// shadow-ray packets converging on a light point, and packets of rays each exactly through a
+// vertex or edge (the triangle tests' float pre-test must keep them).
 TEST(AggregatePacketTest, EveryRayOfAPacketGetsItsSingleRayAnswers) {
   const IsaSupport here = isaSupportHere();
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
@@ -1459,6 +1460,25 @@ TEST(AggregatePacketTest, EveryRayOfAPacketGetsItsSingleRayAnswers) {
         const Vec3 toLight = light - from;
         packet.rays.push_back({from, normalize(toLight)});
         packet.tMax.push_back(p % 5 == 4 ? kInfinity : length(toLight));
+      }
+      packets.push_back(packet);
+    }
+    // Every ray of the packet exactly through a vertex or an edge point of neighbouring triangles
+    // (the float pre-test must keep each: its exact test is a tie or a graze).
+    for (int p = 0; p < 100; ++p) {
+      Packet packet;
+      const TriangleMesh& mesh = s.meshes[pickIndex(rng, s.meshes.size())];
+      const std::size_t first = pickIndex(rng, mesh.triangleCount());
+      const Point3 eye = toPoint(uniformDirection(rng) * (p % 2 == 0 ? 40 : 8));
+      for (int i = 0; i < 16; ++i) {
+        const std::size_t t = (first + static_cast<std::size_t>(i / 4)) % mesh.triangleCount();
+        const Point3& a = mesh.positions[mesh.indices[3 * t]];
+        const Point3& b = mesh.positions[mesh.indices[3 * t + 1]];
+        const Point3& c = mesh.positions[mesh.indices[3 * t + 2]];
+        const std::array<Point3, 4> targets{a, a + (b - a) * 0.5, b, b + (c - b) * rng.uniform()};
+        const Vec3 toTarget = targets[static_cast<std::size_t>(i % 4)] - eye;
+        packet.rays.push_back({eye, normalize(toTarget)});
+        packet.tMax.push_back(p % 3 == 0 ? length(toTarget) * 1.5 : kInfinity);
       }
       packets.push_back(packet);
     }
