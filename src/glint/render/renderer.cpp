@@ -64,6 +64,8 @@ constexpr std::uint32_t kEmitterDimension = kOcclusionDimension + 2;
 // estimate of the pixel's error (four Sobol points already fall one in each quadrant).
 constexpr std::uint32_t kMinAdaptiveSamples = 4;
 
+struct BlockAhead;  // rays of renderBlock's packets traced ahead
+
 // Per-render state shared by every ray of one camera path tree. Lives on the stack of the pixel
 // loop; nothing here allocates.
 struct TraceContext {
@@ -94,6 +96,8 @@ struct TraceContext {
   // Scene::nestedMedia: rays carry the media they are inside (MediumStack) and refract by the
   // ratio of the media's ior at each boundary. Otherwise the stacks stay empty and unread.
   bool nested;
+  // renderBlock's reflection rays traced ahead, for the lane it shades (else null).
+  BlockAhead* ahead = nullptr;
 };
 
 enum class SecondaryKind { Reflection, Refraction };
@@ -146,35 +150,52 @@ class SpawnOrigins {
 // Lights whose camera-hit shadow rays renderBlock traces as packets: the first ones of the scene
 // (point, spot and directional lights among them); the rest are traced one ray at a time.
 constexpr std::size_t kPacketLights = 8;
-// The light index shadeLightSample gets for a sample that is never traced ahead (area lights).
-constexpr std::size_t kUntracedLight = ~std::size_t{0};
 
-// The shadow rays of a packet of camera hits (renderBlock) toward each of the first kPacketLights
-// lights, traced ahead as one packet per light (Aggregate::transmittancePacket). Storage for a
-// tile's blocks, filled anew for each packet (traceCameraShadows).
-struct alignas(64) CameraShadows {
+// The shadow rays of a packet of hits (renderBlock: camera hits, and the hits of their reflection
+// rays) toward each of the first kPacketLights lights, traced ahead as one packet per light
+// (Aggregate::transmittancePacket). Storage for a tile's blocks, filled anew for each packet
+// (tracePacketShadows).
+struct alignas(64) PacketShadows {
   static constexpr std::size_t kLanes = Aggregate::kPacketSize;
+  // rayOf codes other than a ray's index: not traced ahead (the shading samples the light itself);
+  // the light's intensity at the hit is black; the light is on the other side of the surface.
   static constexpr std::uint8_t kNone = 0xff;
+  static constexpr std::uint8_t kBlack = 0xfe;
+  static constexpr std::uint8_t kAway = 0xfd;
   struct LightPacket {
+    std::array<LightSample, kLanes> samples;
     std::array<Ray, kLanes> rays;
     std::array<double, kLanes> tMax;
     std::array<Color, kLanes> transmittance;
   };
   std::array<LightPacket, kPacketLights> lights;
-  // [lane][light]: the index of lane's ray in lights[light], or kNone.
+  // [lane][light]: the index of lane's sample and ray in lights[light], or a code above.
   std::array<std::array<std::uint8_t, kPacketLights>, kLanes> rayOf;
+  // The hit point (Hit::point) each lane's samples were taken at, or null: directLight takes them
+  // for that very hit only.
+  std::array<const Point3*, kLanes> pointOf;
+};
 
-  // The transmittance traced ahead for lane's shadow ray toward `light`, when that ray is exactly
-  // `ray` with `tMax`; else null (the caller traces it).
-  const Color* find(std::size_t lane, std::size_t light, const Ray& ray, double tMax) const {
-    if (light >= kPacketLights) return nullptr;
-    const std::uint8_t r = rayOf[lane][light];
-    if (r == kNone) return nullptr;
-    const LightPacket& packet = lights[light];
-    if (!(packet.tMax[r] == tMax) || std::memcmp(&packet.rays[r], &ray, sizeof(Ray)) != 0) {
-      return nullptr;
-    }
-    return &packet.transmittance[r];
+// What renderBlock traces ahead for a packet of camera rays, and the lane it is shading: the camera
+// hits' shadow rays, their mirror reflection rays (closest hits, one packet) and those hits' shadow
+// rays. trace() takes a reflection's hit from here when its ray is exactly the lane's.
+struct alignas(64) BlockAhead {
+  static constexpr std::size_t kLanes = Aggregate::kPacketSize;
+  static constexpr std::uint8_t kNone = 0xff;
+  PacketShadows cameraShadows;
+  // The reflection rays, their hits and those hits' shadow rays, packed (index r < count).
+  std::array<Ray, kLanes> reflectionRays;
+  std::array<Hit, kLanes> reflectionHits;
+  std::array<bool, kLanes> reflectionFound{};
+  PacketShadows reflectionShadows;
+  std::array<std::uint8_t, kLanes> reflectionOfLane;  // lane → r, or kNone
+  std::size_t lane = 0;                               // the lane being shaded
+
+  // The index r of the shaded lane's reflection ray when it is exactly `ray`, else −1.
+  int reflectionOf(const Ray& ray) const {
+    const std::uint8_t r = reflectionOfLane[lane];
+    if (r == kNone || std::memcmp(&reflectionRays[r], &ray, sizeof(Ray)) != 0) return -1;
+    return r;
   }
 };
 
@@ -202,39 +223,17 @@ struct ShadingPoint {
   // The media on the viewer's side, where the shadow rays start (nested media only; else null).
   const MediumStack* media;
   // A camera hit's shadow rays traced ahead (those of lane tracedLane), or null.
-  const CameraShadows* traced = nullptr;
+  const PacketShadows* traced = nullptr;
   std::size_t tracedLane = 0;
 };
 
-// One light sample's term of DESIGN.md §3:
-//   [(n·l)(n·v) > 0] · T_L(P) · I_L(P) · (kd·|ns·l| + ks·max(0, −v·r)^shininess),
-// with its own shadow ray toward `lightPoint` (tMax = the distance to it, so nothing behind the
-// light, and never the light itself, blocks) or toward infinity when lightPoint is null.
-// Inlined: it runs once per light per hit, and an out-of-line call costs more than its shading.
-// `light`: the light's index, for a shadow ray traced ahead (sp.traced), or kUntracedLight.
-[[gnu::always_inline]] inline Color shadeLightSample(const TraceContext& ctx,
-                                                     const ShadingPoint& sp,
-                                                     const LightSample& sample,
-                                                     const Point3* lightPoint,
-                                                     std::size_t light = kUntracedLight) {
+// The response of the surface at sp to a light sample that reaches it with `transmittance`: the
+// last factors of shadeLightSample's term below.
+[[gnu::always_inline]] inline Color lightResponse(const ShadingPoint& sp, const LightSample& sample,
+                                                  const Color& transmittance) {
+  if (isBlack(transmittance)) return Color();
   const Vec3& l = sample.toPoint;
   const double nl = dot(sp.n, l);
-  // The light and the eye must be on the same side of the surface.
-  if (!(nl * sp.nv > 0)) return Color();
-
-  double tMax;
-  const Ray shadowRay = lightShadowRay(sp.origins, l, lightPoint, tMax);
-  ++ctx.counts.shadow;
-  Color transmittance;
-  if (const Color* ahead =
-          sp.traced != nullptr ? sp.traced->find(sp.tracedLane, light, shadowRay, tMax) : nullptr) {
-    transmittance = *ahead;
-  } else {
-    transmittance = sp.media ? ctx.scene.transmittance(shadowRay, tMax, *sp.media)
-                             : ctx.scene.transmittance(shadowRay, tMax);
-  }
-  if (isBlack(transmittance)) return Color();
-
   const Material& material = sp.material;
   const double nsl = dot(sp.ns, l);
   Color response = nsl * nl > 0 ? material.kd * std::abs(nsl) : Color();
@@ -243,6 +242,25 @@ struct ShadingPoint {
     response += material.ks * std::pow(std::max(0.0, -dot(sp.v, r)), material.shininess);
   }
   return transmittance * sample.intensity * response;
+}
+
+// One light sample's term of DESIGN.md §3:
+//   [(n·l)(n·v) > 0] · T_L(P) · I_L(P) · (kd·|ns·l| + ks·max(0, −v·r)^shininess),
+// with its own shadow ray toward `lightPoint` (tMax = the distance to it, so nothing behind the
+// light, and never the light itself, blocks) or toward infinity when lightPoint is null.
+// Inlined: it runs once per light per hit, and an out-of-line call costs more than its shading.
+[[gnu::always_inline]] inline Color shadeLightSample(const TraceContext& ctx,
+                                                     const ShadingPoint& sp,
+                                                     const LightSample& sample,
+                                                     const Point3* lightPoint) {
+  // The light and the eye must be on the same side of the surface.
+  if (!(dot(sp.n, sample.toPoint) * sp.nv > 0)) return Color();
+  double tMax;
+  const Ray shadowRay = lightShadowRay(sp.origins, sample.toPoint, lightPoint, tMax);
+  ++ctx.counts.shadow;
+  return lightResponse(sp, sample,
+                       sp.media ? ctx.scene.transmittance(shadowRay, tMax, *sp.media)
+                                : ctx.scene.transmittance(shadowRay, tMax));
 }
 
 // Area-light sample budget ("the per-hit ray count falls with depth"): a path that has not split
@@ -317,13 +335,31 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
   if (isBlack(sp.material.kd) && !sp.hasSpecular) return sum;
   const std::vector<Light>& lights = ctx.scene.lights();
   const std::size_t lightCount = lights.size();
+  // The samples renderBlock took ahead at this very hit, with their shadow rays' answers
+  // (tracePacketShadows: the same computations as below).
+  const PacketShadows* ahead =
+      sp.traced != nullptr && sp.traced->pointOf[sp.tracedLane] == &sp.p ? sp.traced : nullptr;
   for (std::size_t i = 0; i < lightCount; ++i) {
     const Light& light = lights[i];
+    if (ahead != nullptr && i < kPacketLights) {
+      const std::uint8_t r = ahead->rayOf[sp.tracedLane][i];
+      if (r == PacketShadows::kBlack) continue;
+      if (r == PacketShadows::kAway) {
+        sum += Color();  // shadeLightSample's answer
+        continue;
+      }
+      if (r != PacketShadows::kNone) {
+        ++ctx.counts.shadow;
+        const PacketShadows::LightPacket& packet = ahead->lights[i];
+        sum += lightResponse(sp, packet.samples[r], packet.transmittance[r]);
+        continue;
+      }
+    }
     // Point lights (the common case) inline: no call and no LightSample through memory.
     if (const auto* point = std::get_if<PointLight>(&light)) {
       const LightSample sample = illuminate(*point, sp.p);
       if (isBlack(sample.intensity)) continue;
-      sum += shadeLightSample(ctx, sp, sample, &point->position, i);
+      sum += shadeLightSample(ctx, sp, sample, &point->position);
       continue;
     }
     if (const auto* area = std::get_if<AreaLight>(&light)) {
@@ -334,8 +370,7 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
     const LightSample sample = illuminate(light, sp.p);
     if (isBlack(sample.intensity)) continue;
     Point3 position;
-    sum += shadeLightSample(ctx, sp, sample, lightPosition(light, position) ? &position : nullptr,
-                            i);
+    sum += shadeLightSample(ctx, sp, sample, lightPosition(light, position) ? &position : nullptr);
   }
   return sum;
 }
@@ -421,7 +456,7 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
     const TraceContext& ctx, const Ray& ray, const Hit& hit, const MediumStack& media,
     const Material& material, const Color& emission, const Normal3& shadingNormal, int depth,
     const Color& weight, bool split, const SampleStream& stream, const TexturedHit* textured,
-    const RayDifferential* differential, const CameraShadows* traced = nullptr,
+    const RayDifferential* differential, const PacketShadows* traced = nullptr,
     std::size_t tracedLane = 0) {
   const int hitDepth = depth + 1;
   // The reprojected hit point and its error bound: ray.at(hit.t) would carry rounding error that
@@ -519,11 +554,20 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
 Color traceFound(const TraceContext& ctx, const Ray& ray, const MediumStack& here, int depth,
                  const Color& weight, bool split, const SampleStream& stream,
                  const RayDifferential* differential, bool found, const Hit& hit,
-                 const CameraShadows* traced = nullptr, std::size_t tracedLane = 0);
+                 const PacketShadows* traced = nullptr, std::size_t tracedLane = 0);
 
 Color trace(const TraceContext& ctx, const Ray& ray, const MediumStack& media, int depth,
             const Color& weight, bool split, const SampleStream& stream,
             const RayDifferential* differential) {
+  // A camera hit's reflection traced ahead by renderBlock (with its shadow rays).
+  if (ctx.ahead != nullptr && depth == 1) {
+    if (const int r = ctx.ahead->reflectionOf(ray); r >= 0) {
+      const auto i = static_cast<std::size_t>(r);
+      return traceFound(ctx, ray, media, depth, weight, split, stream, differential,
+                        ctx.ahead->reflectionFound[i], ctx.ahead->reflectionHits[i],
+                        &ctx.ahead->reflectionShadows, i);
+    }
+  }
   // Aggregate::intersect sets every field of a hit it reports; a miss reads nothing.
   std::optional<Hit> deepHit;  // constructed only past the preallocated depths
   Hit& hit = depth < ctx.hitCount ? ctx.hits[depth] : deepHit.emplace();
@@ -544,7 +588,7 @@ Color trace(const TraceContext& ctx, const Ray& ray, const MediumStack& media, i
 Color traceFound(const TraceContext& ctx, const Ray& ray, const MediumStack& here, int depth,
                  const Color& weight, bool split, const SampleStream& stream,
                  const RayDifferential* differential, bool found, const Hit& hit,
-                 const CameraShadows* traced, std::size_t tracedLane) {
+                 const PacketShadows* traced, std::size_t tracedLane) {
   if (!found) {
     // Fog measured along rays hides whatever lies at infinity.
     if (ctx.fog && ctx.scene.fog()->distance == FogDistance::Ray) {
@@ -1185,14 +1229,14 @@ bool rendersInBlocks(const TraceContext& ctx, const SamplingPlan& plan) {
   return !plan.adaptive && !ctx.path && !ctx.nested && !ctx.textured;
 }
 
-// The shadow rays of a packet's camera hits toward each of the first kPacketLights lights that is
-// not an area light, traced as one packet per light (Aggregate::transmittancePacket) into
-// `shadows`: the rays shadeLightSample would trace at those hits (same side test, origin and
-// tMax). A hit whose material has nothing for a light to act on gets none. Whatever the shading
-// then asks for and finds there is the same ray with the same answer; anything else it traces
-// itself.
-void traceCameraShadows(const TraceContext& ctx, const Ray* rays, const Hit* hits,
-                        const bool* found, int count, CameraShadows& shadows) {
+// The shadow rays of a packet's hits (rays[k] found hits[k] when found[k]) toward each of the
+// first kPacketLights lights that is not an area light, traced as one packet per light
+// (Aggregate::transmittancePacket) into `shadows`: the rays shadeLightSample would trace at those
+// hits, with their light samples (the same computations as directLight's and shadeLightSample's,
+// on the same hit: directLight checks that by the hit point's address). A hit whose material has
+// nothing for a light to act on gets none.
+void tracePacketShadows(const TraceContext& ctx, const Ray* rays, const Hit* hits,
+                        const bool* found, int count, PacketShadows& shadows) {
   const std::vector<Light>& lights = ctx.scene.lights();
   const std::size_t lightCount = std::min(lights.size(), kPacketLights);
   std::array<std::optional<SpawnOrigins>, Aggregate::kPacketSize> origins;
@@ -1200,7 +1244,8 @@ void traceCameraShadows(const TraceContext& ctx, const Ray* rays, const Hit* hit
   std::uint32_t lit = 0;  // bit k: lane k's hit takes light
   for (int k = 0; k < count; ++k) {
     const auto lane = static_cast<std::size_t>(k);
-    shadows.rayOf[lane].fill(CameraShadows::kNone);
+    shadows.rayOf[lane].fill(PacketShadows::kNone);
+    shadows.pointOf[lane] = nullptr;
     if (!found[k]) continue;
     const Hit& hit = hits[k];
     // traceFound passes the rays on to the plain shading only.
@@ -1209,6 +1254,7 @@ void traceCameraShadows(const TraceContext& ctx, const Ray* rays, const Hit* hit
     if (isBlack(material.kd) && isBlack(material.ks)) continue;
     origins[lane].emplace(hit.point, hit.pointError, hit.normal);
     nv[lane] = dot(hit.normal, rays[k].direction);
+    shadows.pointOf[lane] = &hit.point;
     lit |= 1u << k;
   }
   if (lit == 0) return;
@@ -1217,18 +1263,24 @@ void traceCameraShadows(const TraceContext& ctx, const Ray* rays, const Hit* hit
     if (std::holds_alternative<AreaLight>(light)) continue;
     Point3 position;
     const bool positioned = lightPosition(light, position);
-    CameraShadows::LightPacket& packet = shadows.lights[i];
+    PacketShadows::LightPacket& packet = shadows.lights[i];
     int rayCount = 0;
     for (std::uint32_t bits = lit; bits != 0; bits &= bits - 1) {
       const auto lane = static_cast<std::size_t>(std::countr_zero(bits));
       const Point3& p = hits[lane].point;
       // As directLight samples the light and shadeLightSample tests the side.
       const auto* point = std::get_if<PointLight>(&light);
-      const LightSample sample = point != nullptr ? illuminate(*point, p) : illuminate(light, p);
-      if (isBlack(sample.intensity) || !(dot(hits[lane].normal, sample.toPoint) * nv[lane] > 0)) {
+      const auto r = static_cast<std::size_t>(rayCount);
+      LightSample& sample = packet.samples[r];
+      sample = point != nullptr ? illuminate(*point, p) : illuminate(light, p);
+      if (isBlack(sample.intensity)) {
+        shadows.rayOf[lane][i] = PacketShadows::kBlack;
         continue;
       }
-      const auto r = static_cast<std::size_t>(rayCount);
+      if (!(dot(hits[lane].normal, sample.toPoint) * nv[lane] > 0)) {
+        shadows.rayOf[lane][i] = PacketShadows::kAway;
+        continue;
+      }
       packet.rays[r] = lightShadowRay(*origins[lane], sample.toPoint,
                                       positioned ? &position : nullptr, packet.tMax[r]);
       shadows.rayOf[lane][i] = static_cast<std::uint8_t>(rayCount++);
@@ -1238,17 +1290,59 @@ void traceCameraShadows(const TraceContext& ctx, const Ray* rays, const Hit* hit
   }
 }
 
+// The mirror reflection rays shadeHit would trace from a packet's camera hits (of weight 1,
+// unblurred, kr worth tracing), traced as one packet (Aggregate::intersectPacket) into `ahead`,
+// and their hits' shadow rays as tracePacketShadows traces them. trace() takes these hits for
+// exactly these rays; it traces any other ray itself.
+void traceCameraReflections(const TraceContext& ctx, const Ray* rays, const Hit* hits,
+                            const bool* found, int count, BlockAhead& ahead) {
+  ahead.reflectionOfLane.fill(BlockAhead::kNone);
+  if (ctx.maxDepth <= 1) return;
+  int reflections = 0;
+  for (int k = 0; k < count; ++k) {
+    if (!found[k]) continue;
+    const Hit& hit = hits[k];
+    // traceFound's plain shading only (its own material and shading normal).
+    if (ctx.vertexColors && hit.mesh != kNoMesh && !ctx.scene.meshOf(hit).colors.empty()) continue;
+    const Material& material = ctx.scene.materialOf(hit);
+    Color branchWeight;
+    if (material.reflectionBlur > 0 ||
+        !worthTracing(material.kr, Color(1), ctx.minWeight, branchWeight)) {
+      continue;
+    }
+    // As shadeHit computes it.
+    const Normal3& n = hit.normal;
+    const Vec3& v = rays[k].direction;
+    const double nv = dot(n, v);
+    const Normal3& ns = dot(hit.shadingNormal, v) * nv > 0 ? hit.shadingNormal : n;
+    const Vec3 reflected = mirrorDirection(v, n, ns, nv, dot(ns, v), !(ns == n));
+    SpawnOrigins origins(hit.point, hit.pointError, n);
+    const auto r = static_cast<std::size_t>(reflections);
+    ahead.reflectionRays[r] = origins.spawn(reflected);
+    ahead.reflectionOfLane[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(reflections++);
+  }
+  if (reflections == 0) return;
+  std::array<double, Aggregate::kPacketSize> tMax;
+  tMax.fill(kInfinity);
+  ctx.scene.aggregate().intersectPacket(ahead.reflectionRays.data(), reflections, 0, tMax.data(),
+                                        ahead.reflectionHits.data(), ahead.reflectionFound.data());
+  tracePacketShadows(ctx, ahead.reflectionRays.data(), ahead.reflectionHits.data(),
+                     ahead.reflectionFound.data(), reflections, ahead.reflectionShadows);
+}
+
 // The pixels [x0, x0 + width) × [y0, y0 + height) of a tile (at most 4 × 4), sample by sample:
 // the camera rays of one sample of all of them are traced as one packet
 // (Aggregate::intersectPacket), their hits' shadow rays toward each light as one more
-// (traceCameraShadows), and each shaded from its hit. The same rays, hits, values and sums as
-// addSamples gives each pixel alone (a pixel's samples are added in the same order), so the
-// image does not change; the packets only walk the tree once for the block's coherent rays.
-// samples[(y − y0)·4 + (x − x0)] receives pixel (x, y)'s; `shadows` is scratch. False when
-// cancelled (polled per sample, as addSamples does).
+// (tracePacketShadows), their mirror reflections as one more and those hits' shadow rays likewise
+// (traceCameraReflections), and each pixel shaded from its hit. The same rays, hits, values and
+// sums as addSamples gives each pixel alone (a pixel's samples are added in the same order), so
+// the image does not change; the packets only walk the tree once for the block's coherent rays.
+// samples[(y − y0)·4 + (x − x0)] receives pixel (x, y)'s; ctx.ahead (not null) is the scratch.
+// False when cancelled (polled per sample, as addSamples does).
 bool renderBlock(const TraceContext& ctx, const SamplingPlan& plan, int x0, int y0, int width,
                  int height, std::uint64_t seed, const std::atomic<bool>* cancel,
-                 std::array<PixelSamples, Aggregate::kPacketSize>& samples, CameraShadows& shadows) {
+                 std::array<PixelSamples, Aggregate::kPacketSize>& samples) {
+  BlockAhead& ahead = *ctx.ahead;
   constexpr int kSide = 4;
   static_assert(kSide * kSide == Aggregate::kPacketSize);
   std::array<std::optional<PixelCamera>, Aggregate::kPacketSize> pixels;
@@ -1276,12 +1370,14 @@ bool renderBlock(const TraceContext& ctx, const SamplingPlan& plan, int x0, int 
     }
     ctx.scene.aggregate().intersectPacket(rays.data(), count, 0, tMax.data(), hits.data(),
                                           found.data());
-    traceCameraShadows(ctx, rays.data(), hits.data(), found.data(), count, shadows);
+    tracePacketShadows(ctx, rays.data(), hits.data(), found.data(), count, ahead.cameraShadows);
+    traceCameraReflections(ctx, rays.data(), hits.data(), found.data(), count, ahead);
     for (std::size_t k = 0; k < static_cast<std::size_t>(count); ++k) {
       ++ctx.counts.camera;
+      ahead.lane = k;
       const Color value =
           traceFound(ctx, rays[k], ctx.scene.cameraMedia(), 0, Color(1), false,
-                     pixels[k]->stream(n), nullptr, found[k], hits[k], &shadows, k);
+                     pixels[k]->stream(n), nullptr, found[k], hits[k], &ahead.cameraShadows, k);
       PixelSamples& pixel = samples[slotOf[k]];
       addSample(plan, value, pixel);
       ++pixel.n;
@@ -1544,9 +1640,11 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
       tileNonFinite += samples.nonFinite;
     };
     if (rendersInBlocks(ctx, plan)) {
-      // Blocks of 4 × 4 pixels, their camera rays traced as packets (renderBlock). The shadow
-      // rays' scratch on cache lines of its own, as the hits are.
-      const auto shadows = std::make_unique<CameraShadows>();
+      // Blocks of 4 × 4 pixels, their camera rays traced as packets (renderBlock). The scratch
+      // of what it traces ahead on cache lines of its own, as the hits are.
+      const auto ahead = std::make_unique<BlockAhead>();
+      TraceContext blockContext = ctx;
+      blockContext.ahead = ahead.get();
       for (int row = y0; row < y1 && !abandoned; row += 4) {
         for (int column = x0; column < x1; column += 4) {
           const int width = std::min(4, x1 - column);
@@ -1554,8 +1652,8 @@ void renderInto(const Scene& scene, const RenderOptions& options, Film& film, Re
           std::array<PixelSamples, Aggregate::kPacketSize> block{};
           // Another thread's stop, polled per block; the caller's cancel flag per sample.
           if (cancelled.load(std::memory_order_relaxed) ||
-              !renderBlock(ctx, plan, column, row, width, height, seed, options.cancel, block,
-                           *shadows)) {
+              !renderBlock(blockContext, plan, column, row, width, height, seed, options.cancel,
+                           block)) {
             cancelled.store(true);
             abandoned = true;
             break;
