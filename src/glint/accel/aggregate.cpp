@@ -934,8 +934,13 @@ struct PacketRays {
   alignas(64) float tMax[kPacketLanes];  // each ray's closestF, lowered as it finds hits
   SlabRows rows;                         // of Node, shared: one direction octant per packet
 
-  // Every lane empty (its ray never overlaps a box), the packet's tMin set.
-  explicit PacketRays(double tMinimum) {
+  // Every lane empty (its ray never overlaps a box), the packet's tMin set, its octant that of
+  // `first`'s direction.
+  PacketRays(double tMinimum, const Ray& first)
+      : rows(kSlabRows[static_cast<std::size_t>(
+            static_cast<unsigned>(std::signbit(first.direction.x)) |
+            static_cast<unsigned>(std::signbit(first.direction.y)) << 1 |
+            static_cast<unsigned>(std::signbit(first.direction.z)) << 2)]) {
     const float tMinF = floatBelow(tMinimum);
     for (int i = 0; i < kPacketLanes; ++i) {
       tMin[i] = tMinF;
@@ -945,6 +950,8 @@ struct PacketRays {
       }
     }
   }
+  // Whether the ray of boxRay has the packet's octant (the others are traced alone).
+  bool takes(const BoxRay& boxRay) const { return boxRay.rows.nearRow == rows.nearRow; }
   // Lane i takes the ray of boxRay with the far bound tMaxF.
   void set(int i, const BoxRay& boxRay, float tMaxF) {
     tMax[i] = tMaxF;
@@ -1021,14 +1028,11 @@ struct PacketEntry {
   }
   std::array<ClosestHitSearch, kPacketSize> search;
   ShapeHit scratch;
-  PacketRays packet(tMin);
+  PacketRays packet(tMin, rays[0]);
   std::uint32_t active = 0;
-  const std::uint32_t octant = static_cast<std::uint32_t>(std::signbit(rays[0].direction.x)) |
-                               static_cast<std::uint32_t>(std::signbit(rays[0].direction.y)) << 1 |
-                               static_cast<std::uint32_t>(std::signbit(rays[0].direction.z)) << 2;
   for (int i = 0; i < count; ++i) {
     const BoxRay boxRay(rays[i]);
-    if (boxRay.rows.nearRow != kSlabRows[octant].nearRow) {  // another octant: alone
+    if (!packet.takes(boxRay)) {  // another octant: alone
       found[i] = GLINT_ISA_KERNEL(intersect)(rays[i], tMin, tMax[i], hits[i]);
       continue;
     }
@@ -1036,7 +1040,6 @@ struct PacketEntry {
     packet.set(i, boxRay, search[i].closestF);
     active |= 1u << i;
   }
-  packet.rows = kSlabRows[octant];
 
   const LeafView leaves{primitives_.data(), leafRefs_.data(), leafSpheres_.data(), meshes_.data()};
   // Depth first, nearest child first (by its rays' least entry distance); each child goes on with
@@ -1233,16 +1236,13 @@ inline bool crossTriangles(const TriangleMesh& mesh, const Color& kt, std::uint3
     }
     return;
   }
-  PacketRays packet(tMin);
+  PacketRays packet(tMin, rays[0]);
   std::array<WatertightRay, kPacketSize> wrays;  // set up at each ray's first triangle leaf
   std::array<bool, kPacketSize> wrayReady{};
   std::uint32_t active = 0;
-  const std::uint32_t octant = static_cast<std::uint32_t>(std::signbit(rays[0].direction.x)) |
-                               static_cast<std::uint32_t>(std::signbit(rays[0].direction.y)) << 1 |
-                               static_cast<std::uint32_t>(std::signbit(rays[0].direction.z)) << 2;
   for (int i = 0; i < count; ++i) {
     const BoxRay boxRay(rays[i]);
-    if (boxRay.rows.nearRow != kSlabRows[octant].nearRow) {  // another octant: alone
+    if (!packet.takes(boxRay)) {  // another octant: alone
       results[i] = GLINT_ISA_KERNEL(transmittance)(rays[i], tMin, tMax[i]);
       continue;
     }
@@ -1263,7 +1263,6 @@ inline bool crossTriangles(const TriangleMesh& mesh, const Color& kt, std::uint3
     packet.set(i, boxRay, floatAbove(tMax[i] * kFarScale));
     active |= 1u << i;
   }
-  packet.rows = kSlabRows[octant];
 
   // Ray i is blocked: black, and out of the packet.
   const auto block = [&](std::size_t i) {
