@@ -222,7 +222,8 @@ struct ShadingPoint {
   SpawnOrigins& origins;  // of p, pError and n
   // The media on the viewer's side, where the shadow rays start (nested media only; else null).
   const MediumStack* media;
-  // A camera hit's shadow rays traced ahead (those of lane tracedLane), or null.
+  // This hit's shadow rays as renderBlock traced them ahead (lane tracedLane's of a packet), or
+  // null.
   const PacketShadows* traced = nullptr;
   std::size_t tracedLane = 0;
 };
