@@ -26,7 +26,7 @@ std::uint32_t MeshCollector::vertexIndex(const ValueTree& tree, Group& g,
   return it->second;
 }
 
-void MeshCollector::add(const ValueTree& tree, const std::string& material,
+void MeshCollector::add(ValueTree& tree, const std::string& material,
                         const CollectedVertex& a, const CollectedVertex& b,
                         const CollectedVertex& c, const TextPosition& at) {
   const bool normals = a.normal[0] != kNoValue;
@@ -42,6 +42,7 @@ void MeshCollector::add(const ValueTree& tree, const std::string& material,
     groups_.push_back(std::move(g));
   }
   Group& g = groups_[it->second];
+  tree.noteLine(at);
   for (const CollectedVertex* v : {&a, &b, &c}) g.indices.push_back(vertexIndex(tree, g, *v));
   g.triangleAt.push_back(at);
   ++triangles_;

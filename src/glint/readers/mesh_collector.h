@@ -25,8 +25,9 @@ struct CollectedVertex {
 class MeshCollector {
  public:
   // Adds triangle (a, b, c) — right-handed order — to the mesh of `material` ("" for none) whose
-  // vertices have the same kinds of data as these. `at` is where messages about it point.
-  void add(const ValueTree& tree, const std::string& material, const CollectedVertex& a,
+  // vertices have the same kinds of data as these. `at` is where messages about it point (its line
+  // is noted in `tree` now: emit() adds the triangle's values there).
+  void add(ValueTree& tree, const std::string& material, const CollectedVertex& a,
            const CollectedVertex& b, const CollectedVertex& c, const TextPosition& at);
   // Emits the meshes as object entities, in the order their first triangles came, each with
   // `smooth` true when it has normals and false otherwise.

@@ -57,11 +57,21 @@ void ValueTree::noteLine(const TextPosition& where) {
     lines_.emplace_back(start, where.line);
     return;
   }
-  // Out of order (a reader that adds values before earlier ones): keep the table sorted.
+  // Out of order (a reader that adds values before earlier ones, such as the NFF reader's meshes,
+  // added at the end at their polygons' lines): keep the table sorted. Such values come in runs
+  // on one line, line after line, so the few lines from the one found last are looked at first.
+  for (std::size_t k = lastFound_; k < std::min(lastFound_ + 8, lines_.size()); ++k) {
+    if (lines_[k].first == start) {
+      lastFound_ = k;
+      return;
+    }
+  }
   const auto it =
       std::lower_bound(lines_.begin(), lines_.end(), start,
                        [](const auto& line, std::uint32_t s) { return line.first < s; });
+  const auto index = static_cast<std::size_t>(it - lines_.begin());
   if (it == lines_.end() || it->first != start) lines_.insert(it, {start, where.line});
+  lastFound_ = index;
 }
 
 std::uint32_t ValueTree::storeText(std::string_view text) {

@@ -65,6 +65,10 @@ class ValueTree {
   // next child without copying it.
   ValueId addScalar(std::string_view text, const TextPosition& where);
   ValueId addNull(const TextPosition& where);
+  // Notes the line of `where` (position() of any value there resolves its line and column).
+  // Every add() notes its own; a reader that adds values later at a position it has passed (the
+  // mesh collector) notes it when it passes, so that the table of lines grows in order.
+  void noteLine(const TextPosition& where);
   ValueId open(ValueKind kind, const TextPosition& where);
   void close();
   void attach(ValueId id);
@@ -87,7 +91,6 @@ class ValueTree {
     std::uint32_t b;      // scalar: text length; list/map: items / entries
   };
   ValueId add(ValueKind kind, const TextPosition& where, std::uint32_t a, std::uint32_t b);
-  void noteLine(const TextPosition& where);
   std::uint32_t storeText(std::string_view text);
 
   std::vector<Value> values_;
@@ -104,6 +107,7 @@ class ValueTree {
   // (offset of the first character of a line, line number) for every line holding a value,
   // ascending.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> lines_;
+  std::size_t lastFound_ = 0;  // the entry of lines_ an out-of-order value was last noted at
   // Open collections: the collection and where its children start in `pending_`.
   struct Frame {
     ValueId id;
