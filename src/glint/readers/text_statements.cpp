@@ -202,6 +202,7 @@ ParseResult parseSceneText(std::string_view text, const std::string& file,
                            const std::atomic<bool>* cancel, StatementReader read) {
   SceneDescription scene = sceneWithFile(file, baseDirectory);
   scene.files[0]->bytes = text.size();
+  scene.files[0]->values.reserveForText(text.size());  // as the YAML reader: no regrowth
   return read(text, std::move(scene), cancel);
 }
 
@@ -211,6 +212,7 @@ ParseResult readSceneTextFile(const std::filesystem::path& path, const std::stri
   if (base.empty()) base = ".";
   SceneDescription scene = sceneWithFile(name, base);
   const std::string text = readWholeSceneFile(path, name, *scene.files[0]);
+  scene.files[0]->values.reserveForText(text.size());  // as the YAML reader: no regrowth
   return read(text, std::move(scene), cancel);
 }
 
