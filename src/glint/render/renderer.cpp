@@ -209,6 +209,19 @@ inline Ray lightShadowRay(SpawnOrigins& origins, const Vec3& toPoint, const Poin
   return shadowRay;
 }
 
+// Whether a hit takes its mesh's vertex colours (they tint kd and ka there): the branch traceFound
+// and tracePath take, and the one renderBlock's traced-ahead rays leave to the shading.
+inline bool takesVertexColours(const TraceContext& ctx, const Hit& hit) {
+  return ctx.vertexColors && hit.mesh != kNoMesh && !ctx.scene.meshOf(hit).colors.empty();
+}
+
+// The shading normal to shade a hit with, seen along the unit direction v (nv = n·v): one facing
+// the other way from the geometric normal n would shade a back face; n is used then.
+inline const Normal3& facingShadingNormal(const Normal3& shadingNormal, const Normal3& n,
+                                          const Vec3& v, double nv) {
+  return dot(shadingNormal, v) * nv > 0 ? shadingNormal : n;
+}
+
 // Shading inputs at one hit that every light sample shares (references into trace()'s frame: no
 // copies per hit).
 struct ShadingPoint {
@@ -467,9 +480,8 @@ bool worthTracing(const Color& factor, const Color& weight, double minWeight, Co
   const Normal3& n = hit.normal;  // geometric: side decisions and ray origins
   const Vec3& v = ray.direction;  // unit for every ray the renderer creates
   const double nv = dot(n, v);
-  // Shading normal: directions and the diffuse/specular terms. One facing the other way from the
-  // geometric normal as seen along v would shade a back face; the geometric one is used then.
-  const Normal3& ns = dot(shadingNormal, v) * nv > 0 ? shadingNormal : n;
+  // Shading normal: directions and the diffuse/specular terms.
+  const Normal3& ns = facingShadingNormal(shadingNormal, n, v, nv);
   const double nsv = dot(ns, v);
 
   SpawnOrigins origins(p, pError, n);
@@ -601,7 +613,7 @@ Color traceFound(const TraceContext& ctx, const Ray& ray, const MediumStack& her
   Color color;
   if (ctx.textured) {
     color = traceTexturedHit(ctx, ray, hit, here, depth, weight, split, stream, differential);
-  } else if (ctx.vertexColors && hit.mesh != kNoMesh && !ctx.scene.meshOf(hit).colors.empty()) {
+  } else if (takesVertexColours(ctx, hit)) {
     color = traceVertexColouredHit(ctx, ray, hit, here, depth, weight, split, stream);
   } else {
     color = shadeHit(ctx, ray, hit, here, ctx.scene.materialOf(hit), ctx.scene.emissionOf(hit),
@@ -876,7 +888,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
       textured.shadingNormal = hit.shadingNormal;
     }
     Material& material = textured.material;
-    if (ctx.vertexColors && hit.mesh != kNoMesh && !scene.meshOf(hit).colors.empty()) {
+    if (takesVertexColours(ctx, hit)) {
       const Color tint = scene.aggregate().vertexColor(hit);
       material.kd *= tint;
       material.ka *= tint;
@@ -895,7 +907,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
     const Normal3& n = hit.normal;
     const Vec3& v = ray.direction;
     const double nv = dot(n, v);
-    const Normal3& ns = dot(textured.shadingNormal, v) * nv > 0 ? textured.shadingNormal : n;
+    const Normal3& ns = facingShadingNormal(textured.shadingNormal, n, v, nv);
     const double nsv = dot(ns, v);
     SpawnOrigins origins(p, hit.pointError, n);
     radiance +=
@@ -1250,7 +1262,7 @@ void tracePacketShadows(const TraceContext& ctx, const Ray* rays, const Hit* hit
     if (!found[k]) continue;
     const Hit& hit = hits[k];
     // traceFound passes the rays on to the plain shading only.
-    if (ctx.vertexColors && hit.mesh != kNoMesh && !ctx.scene.meshOf(hit).colors.empty()) continue;
+    if (takesVertexColours(ctx, hit)) continue;
     const Material& material = ctx.scene.materialOf(hit);
     if (isBlack(material.kd) && isBlack(material.ks)) continue;
     origins[lane].emplace(hit.point, hit.pointError, hit.normal);
@@ -1304,7 +1316,7 @@ void traceCameraReflections(const TraceContext& ctx, const Ray* rays, const Hit*
     if (!found[k]) continue;
     const Hit& hit = hits[k];
     // traceFound's plain shading only (its own material and shading normal).
-    if (ctx.vertexColors && hit.mesh != kNoMesh && !ctx.scene.meshOf(hit).colors.empty()) continue;
+    if (takesVertexColours(ctx, hit)) continue;
     const Material& material = ctx.scene.materialOf(hit);
     Color branchWeight;
     if (material.reflectionBlur > 0 ||
@@ -1315,7 +1327,7 @@ void traceCameraReflections(const TraceContext& ctx, const Ray* rays, const Hit*
     const Normal3& n = hit.normal;
     const Vec3& v = rays[k].direction;
     const double nv = dot(n, v);
-    const Normal3& ns = dot(hit.shadingNormal, v) * nv > 0 ? hit.shadingNormal : n;
+    const Normal3& ns = facingShadingNormal(hit.shadingNormal, n, v, nv);
     const Vec3 reflected = mirrorDirection(v, n, ns, nv, dot(ns, v), !(ns == n));
     SpawnOrigins origins(hit.point, hit.pointError, n);
     const auto r = static_cast<std::size_t>(reflections);
