@@ -156,7 +156,7 @@ TEST(Instancing, ManyInstancesEqualTheWrittenOutObjectsOnAnyThreadCount) {
   const Film one = renderText(scene, 1);
   const Film two = renderText(scene, 2);
   expectSameBytes(one, expected);  // the material replaced only the sphere's
-  EXPECT_EQ(two.pixels(), one.pixels());
+  EXPECT_TRUE(std::ranges::equal(two.pixels(), one.pixels()));
 }
 
 TEST(Instancing, InstanceMaterialReplacesOnlyMissingMaterials) {

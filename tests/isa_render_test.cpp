@@ -45,7 +45,9 @@ std::vector<Color> renderWith(const fs::path& scene, Isa isa, Isa& used) {
   spec.isa = isa;
   std::vector<Color> pixels;
   RenderJobEvents events;
-  events.imageFinished = [&pixels](const Film& film) { pixels = film.pixels(); };
+  events.imageFinished = [&pixels](const Film& film) {
+    pixels.assign(film.pixels().begin(), film.pixels().end());
+  };
   const RenderJobResult result = runRenderJob(spec, events);
   fs::remove(spec.output);
   used = result.scene.isa;

@@ -4,6 +4,7 @@
 // shadow rays keep one solid's transmittance across a same-material boundary, material priorities
 // decide who owns an overlap, and the camera knows the media it starts in.
 #include <gtest/gtest.h>
+#include <algorithm>
 
 #include <cmath>
 #include <cstdint>
@@ -102,7 +103,7 @@ TEST(NestedDielectrics, NestedRendersAreTheSameOnAnyThreadCount) {
   one.tileSize = 7;
   RenderOptions two;
   two.threads = 2;
-  EXPECT_EQ(render(nested, one).pixels(), render(nested, two).pixels());
+  EXPECT_TRUE(std::ranges::equal(render(nested, one).pixels(), render(nested, two).pixels()));
 }
 
 // Two concentric spheres of radius 1 and 0.5 at the origin, the inner of `innerMaterial`.

@@ -12,19 +12,26 @@
 
 namespace glint {
 
-// Reserves room for n elements in `out` (empty, or not yet larger) and advises huge pages for the
-// whole 2 MiB pages inside that room, before anything touches it. Below 4 MiB it does nothing.
-template <typename T>
-void reserveOnHugePages(std::vector<T>& out, std::size_t n) {
+// Advises huge pages for the whole 2 MiB pages inside [data, data + bytes), before anything
+// touches them. Below 4 MiB it does nothing.
+inline void adviseHugePages(void* data, std::size_t bytes) {
   constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-  if (n * sizeof(T) < 2 * kHugePage) return;
-  out.reserve(n);
-  const auto begin = reinterpret_cast<std::uintptr_t>(out.data());
+  if (bytes < 2 * kHugePage) return;
+  const auto begin = reinterpret_cast<std::uintptr_t>(data);
   const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
-  const std::uintptr_t last = (begin + n * sizeof(T)) & ~(kHugePage - 1);
+  const std::uintptr_t last = (begin + bytes) & ~(kHugePage - 1);
   if (last > first) {
     static_cast<void>(::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE));
   }
+}
+
+// Reserves room for n elements in `out` (empty, or not yet larger) and advises huge pages for the
+// whole 2 MiB pages inside that room (adviseHugePages).
+template <typename T>
+void reserveOnHugePages(std::vector<T>& out, std::size_t n) {
+  if (n * sizeof(T) < (std::size_t{4} << 20)) return;
+  out.reserve(n);
+  adviseHugePages(out.data(), n * sizeof(T));
 }
 
 }  // namespace glint
