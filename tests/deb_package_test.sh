@@ -38,6 +38,13 @@ dev_files="$(dpkg-deb -c "$dev")"
 grep -q '\./usr/bin/glint$' <<<"$runtime_files" || fail "no /usr/bin/glint in the package"
 grep -q '\./usr/libexec/glint/glint-mesh-reader$' <<<"$runtime_files" ||
   fail "no /usr/libexec/glint/glint-mesh-reader in the package"
+grep -q '\./usr/libexec/glint/glint-preview-http\.so$' <<<"$runtime_files" ||
+  fail "no /usr/libexec/glint/glint-preview-http.so in the package"
+if [[ -f "$build/glint-mpi.so" ]]; then
+  grep -q '\./usr/libexec/glint/glint-mpi\.so$' <<<"$runtime_files" ||
+    fail "no /usr/libexec/glint/glint-mpi.so in the package"
+  grep -q "libopenmpi" <<<"$depends" || fail "glint's Depends lack libopenmpi (its MPI module)"
+fi
 grep -q 'usr/include/glint/glint.h$' <<<"$dev_files" || fail "no glint.h in libglint-dev"
 grep -q 'cmake/glint/glintConfig.cmake$' <<<"$dev_files" || fail "no CMake package in libglint-dev"
 grep -q 'libglint\.a$' <<<"$dev_files" || fail "no libglint.a in libglint-dev"
@@ -49,4 +56,10 @@ dpkg-deb -x "$runtime" "$work/root"
 # A mesh scene: the unpacked glint reads its mesh with the unpacked reader (../libexec/glint).
 "$work/root/usr/bin/glint" render "$source/scenes/mesh.yaml" -o "$work/mesh.png" --quiet
 [[ -s "$work/mesh.png" ]] || fail "the unpacked glint did not render a mesh scene"
+# A preview: the unpacked glint loads the unpacked HTTP module (../libexec/glint).
+"$work/root/usr/bin/glint" render "$source/tests/cli/small.yaml" -o "$work/previewed.png" \
+  --preview 0 --preview-linger 0 2>"$work/preview.log" ||
+  fail "the unpacked glint could not show a preview: $(cat "$work/preview.log")"
+grep -q 'preview at http://127.0.0.1:' "$work/preview.log" ||
+  fail "the unpacked glint did not serve a preview: $(cat "$work/preview.log")"
 echo "ok: $(basename "$runtime") and $(basename "$dev")"

@@ -34,6 +34,17 @@ archive="$(find "$prefix" -name libglint.a)"
 "$build/glint" render "$source/scenes/mesh.yaml" -o "$work/mesh-in-tree.png" --quiet
 cmp "$work/mesh.png" "$work/mesh-in-tree.png" ||
   fail "the installed glint renders scenes/mesh.yaml other than the build tree's"
+[[ -f "$prefix/libexec/glint/glint-preview-http.so" ]] ||
+  fail "no libexec/glint/glint-preview-http.so"
+if [[ -f "$build/glint-mpi.so" ]]; then
+  [[ -f "$prefix/libexec/glint/glint-mpi.so" ]] || fail "no libexec/glint/glint-mpi.so"
+fi
+# A preview from the installed command, with the installed module.
+"$prefix/bin/glint" render "$source/tests/cli/small.yaml" -o "$work/previewed.png" \
+  --preview 0 --preview-linger 0 2>"$work/preview.log" ||
+  fail "the installed glint could not show a preview: $(cat "$work/preview.log")"
+grep -q 'preview at http://127.0.0.1:' "$work/preview.log" ||
+  fail "the installed glint did not serve a preview: $(cat "$work/preview.log")"
 echo "installed: $(cd "$prefix" && find . -type f | wc -l) files (${config#"$prefix"/}, ${archive#"$prefix"/})"
 
 generator=()

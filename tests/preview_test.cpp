@@ -118,6 +118,41 @@ TEST_F(PreviewCli, BadPreviewOptionsExitWithStatus2) {
   }
 }
 
+// The HTTP side is a module (glint-preview-http.so, beside glint in the build tree) loaded only
+// for a preview: one that is missing or is another module is a clear error before any work.
+TEST_F(PreviewCli, APreviewModuleThatCannotLoadIsAClearError) {
+  const std::string missing = (work_ / "no-such-module.so").string();
+  const std::string other = (fs::path(GLINT_BINARY_DIR) / "glint-mesh-reader").string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {missing, "cannot start the preview: cannot load " + missing},
+      {other, "cannot start the preview: cannot load " + other},
+  };
+  for (const auto& [module, message] : cases) {
+    ASSERT_EQ(::setenv("GLINT_PREVIEW_MODULE", module.c_str(), 1), 0);
+    const RunResult result = run({"render", small(), "-o", "out.png", "--preview", "0"});
+    ::unsetenv("GLINT_PREVIEW_MODULE");
+    EXPECT_EQ(result.status, 2) << result.err;
+    EXPECT_TRUE(contains(result.err, "glint: error: " + message)) << result.err;
+    EXPECT_FALSE(fs::exists(work_ / "out.png"));
+  }
+}
+
+#ifdef GLINT_MPI
+// A module of this build that is not the preview's is refused by its identity, not called.
+TEST_F(PreviewCli, AnotherModuleInPlaceOfThePreviewsIsRefused) {
+  const std::string mpi = (fs::path(GLINT_BINARY_DIR) / "glint-mpi.so").string();
+  ASSERT_EQ(::setenv("GLINT_PREVIEW_MODULE", mpi.c_str(), 1), 0);
+  const RunResult result = run({"render", small(), "-o", "out.png", "--preview", "0"});
+  ::unsetenv("GLINT_PREVIEW_MODULE");
+  EXPECT_EQ(result.status, 2) << result.err;
+  EXPECT_TRUE(contains(result.err, "glint: error: cannot start the preview: " + mpi +
+                                       " is not the module of this glint (it is 'glint "))
+      << result.err;
+  EXPECT_TRUE(contains(result.err, "module mpi interface 1'; expected 'glint ")) << result.err;
+  EXPECT_FALSE(fs::exists(work_ / "out.png"));
+}
+#endif
+
 TEST_F(PreviewCli, AnAddressOthersCanReachComesWithAWarning) {
   const RunResult result = run({"render", small(), "-o", "out.png", "--preview", "0",
                                 "--preview-bind", "0.0.0.0", "--preview-linger", "0"});

@@ -1,6 +1,5 @@
 #include "glint/cluster/link.h"
 
-#include <mpi.h>
 #include <pthread.h>
 #include <time.h>
 
@@ -8,6 +7,8 @@
 #include <climits>
 #include <stdexcept>
 #include <utility>
+
+#include "glint/cluster/mpi_transport.h"
 
 namespace glint::cluster {
 namespace {
@@ -27,13 +28,14 @@ double threadCpuSeconds() {
 // A message on its way out or in.
 struct Link::Pending {
   std::string bytes;
-  MPI_Request request = MPI_REQUEST_NULL;  // MPI_REQUEST_NULL once complete
-  bool counted = false;                    // sent by send(), so part of unsent_
+  MpiRequest request;    // inactive once complete
+  bool counted = false;  // sent by send(), so part of unsent_
   int peer = 0;
   int tag = 0;
 };
 
-Link::Link(std::vector<int> watched, LinkTiming timing) : timing_(timing) {
+Link::Link(MpiTransport& mpi, std::vector<int> watched, LinkTiming timing)
+    : mpi_(mpi), timing_(timing) {
   const Clock::time_point now = Clock::now();
   for (const int peer : watched) watched_[peer] = Peer{now, now};
   thread_ = std::thread([this] { run(); });
@@ -117,8 +119,7 @@ void Link::run() {
   }
   // Abandoned transfers: their peers are gone or the job is over; MPI frees the requests at exit.
   for (std::list<Pending>* transfers : {&sending, &receiving})
-    for (Pending& p : *transfers)
-      if (p.request != MPI_REQUEST_NULL) MPI_Request_free(&p.request);
+    for (Pending& p : *transfers) mpi_.release(p.request);
 }
 
 void Link::workStarts() {
@@ -147,11 +148,11 @@ bool Link::sendQueued(std::list<Pending>& pending) {
   for (Message& message : outgoing) {
     const bool counted = message.tag != Tag::Heartbeat;
     // A heartbeat made here is not counted in unsent_; every send() is.
-    Pending& p = pending.emplace_back(Pending{std::move(message.bytes), MPI_REQUEST_NULL, counted,
+    Pending& p = pending.emplace_back(Pending{std::move(message.bytes), MpiRequest{}, counted,
                                               message.peer, static_cast<int>(message.tag)});
     bytes += p.bytes.size();
-    if (MPI_Isend(p.bytes.data(), static_cast<int>(p.bytes.size()), MPI_BYTE, message.peer,
-                  static_cast<int>(message.tag), MPI_COMM_WORLD, &p.request) != MPI_SUCCESS) {
+    if (!mpi_.send(p.bytes.data(), static_cast<int>(p.bytes.size()), message.peer,
+                   static_cast<int>(message.tag), p.request)) {
       failed += counted ? 1 : 0;
       peerFailed(message.peer);
       pending.pop_back();
@@ -185,13 +186,12 @@ bool Link::completeSends(std::list<Pending>& pending) {
   if (!pending.empty()) workStarts();
   std::size_t completed = 0;
   for (auto it = pending.begin(); it != pending.end();) {
-    int done = 0;
-    if (MPI_Test(&it->request, &done, MPI_STATUS_IGNORE) != MPI_SUCCESS) {
+    const MpiTest state = mpi_.test(it->request);
+    if (state == MpiTest::Failed) {
       // The send failed: its peer is gone. The request is freed by MPI on error.
-      done = 1;
       peerFailed(it->peer);
     }
-    if (!done) {
+    if (state == MpiTest::Pending) {
       ++it;
       continue;
     }
@@ -214,30 +214,19 @@ bool Link::receiveArrived(std::list<Pending>& receiving) {
   // Every message that arrived is matched (MPI_Improbe) and received without blocking
   // (MPI_Imrecv): a blocking receive of a fragmented message would spin until the sender's next
   // poll. An error here (a broken connection) is left to the silence watch.
-  for (;;) {
-    int flag = 0;
-    MPI_Message handle = MPI_MESSAGE_NULL;
-    MPI_Status status;
-    if (MPI_Improbe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &handle, &status) !=
-            MPI_SUCCESS ||
-        !flag)
-      break;
-    int count = 0;
-    MPI_Get_count(&status, MPI_BYTE, &count);
+  MpiArrival arrival;
+  while (mpi_.probe(arrival)) {
     Pending& p =
-        receiving.emplace_back(Pending{std::string(static_cast<std::size_t>(count), '\0'),
-                                       MPI_REQUEST_NULL, false, status.MPI_SOURCE, status.MPI_TAG});
-    if (MPI_Imrecv(p.bytes.data(), count, MPI_BYTE, &handle, &p.request) != MPI_SUCCESS) {
+        receiving.emplace_back(Pending{std::string(static_cast<std::size_t>(arrival.bytes), '\0'),
+                                       MpiRequest{}, false, arrival.source, arrival.tag});
+    if (!mpi_.receive(p.bytes.data(), arrival, p.request)) {
       receiving.pop_back();
       break;
     }
     any = true;
   }
   for (Pending& p : receiving) {
-    int done = 0;
-    if (p.request != MPI_REQUEST_NULL &&
-        MPI_Test(&p.request, &done, MPI_STATUS_IGNORE) == MPI_SUCCESS && done)
-      any = true;
+    if (p.request.active && mpi_.test(p.request) == MpiTest::Done) any = true;
   }
   // Delivered in the order they were matched from each peer (MPI's order), so a peer that stopped
   // halfway through a message holds back only its own later messages.
@@ -245,7 +234,7 @@ bool Link::receiveArrived(std::list<Pending>& receiving) {
   std::vector<int> held;  // peers with an earlier message still under way
   for (auto it = receiving.begin(); it != receiving.end();) {
     const bool waits = std::find(held.begin(), held.end(), it->peer) != held.end();
-    if (it->request != MPI_REQUEST_NULL || waits) {
+    if (it->request.active || waits) {
       if (!waits) held.push_back(it->peer);
       ++it;
       continue;

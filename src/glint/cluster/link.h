@@ -21,6 +21,8 @@
 
 #include "glint/cluster/protocol.h"
 
+#include "glint/cluster/mpi_transport.h"
+
 namespace glint::cluster {
 
 struct LinkTiming {
@@ -51,9 +53,9 @@ struct LinkCounters {
 
 class Link {
  public:
-  // Starts the thread; MPI must be initialised and this process must make no other MPI call until
-  // stop(). `watched`: the peers whose silence is reported and who get heartbeats.
-  Link(std::vector<int> watched, LinkTiming timing);
+  // Starts the thread; MPI must be initialised (through `mpi`) and this process must make no other
+  // MPI call until stop(). `watched`: the peers whose silence is reported and who get heartbeats.
+  Link(MpiTransport& mpi, std::vector<int> watched, LinkTiming timing);
   ~Link();
   Link(const Link&) = delete;
   Link& operator=(const Link&) = delete;
@@ -92,6 +94,7 @@ class Link {
   // A send to `peer` failed: it is reported (Tag::Unreachable) and no longer watched.
   void peerFailed(int peer);
 
+  MpiTransport& mpi_;
   LinkTiming timing_;
   mutable std::mutex mutex_;
   std::condition_variable arrived_;  // inbox_ grew

@@ -1,12 +1,12 @@
 #include "glint/cluster/session.h"
 
-#include <mpi.h>
-
 #include <charconv>
 #include <cstdlib>
 #include <stdexcept>
 #include <string_view>
 #include <vector>
+
+#include "glint/cluster/mpi_transport.h"
 
 namespace glint::cluster {
 namespace {
@@ -31,29 +31,20 @@ LinkTiming timingFromEnvironment() {
 
 }  // namespace
 
-Session::Session() : timing_(timingFromEnvironment()) {
-  int provided = 0;
-  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided);
-  if (provided < MPI_THREAD_SERIALIZED) {
-    MPI_Finalize();
+Session::Session() : mpi_(mpiTransport()), timing_(timingFromEnvironment()) {
+  // MPI_THREAD_SERIALIZED: only the link's thread calls MPI while it runs.
+  if (!mpi_.start())
     throw std::runtime_error("this MPI library does not allow MPI calls from a second thread");
-  }
-  // A failed send to a rank that died is the link's to report (Tag::Silent), not a reason for
-  // MPI to abort this process before rank 0 has saved its checkpoint.
-  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-  MPI_Comm_size(MPI_COMM_WORLD, &size_);
-  char name[MPI_MAX_PROCESSOR_NAME] = {};
-  int length = 0;
-  MPI_Get_processor_name(name, &length);
-  host_.assign(name, static_cast<std::size_t>(length));
+  rank_ = mpi_.rank();
+  size_ = mpi_.size();
+  host_ = mpi_.host();
   std::vector<int> watched;
   if (rank_ == 0) {
     for (int peer = 1; peer < size_; ++peer) watched.push_back(peer);
   } else {
     watched.push_back(0);
   }
-  link_ = std::make_unique<Link>(std::move(watched), timing_);
+  link_ = std::make_unique<Link>(mpi_, std::move(watched), timing_);
 }
 
 Session::~Session() {
@@ -64,7 +55,7 @@ int Session::finish(int status, bool orderly) {
   if (finished_) return status;
   finished_ = true;
   link_->stop();
-  if (orderly) MPI_Finalize();
+  if (orderly) mpi_.finalize();
   return status;
 }
 

@@ -6,15 +6,17 @@
 #include <string>
 
 #include "glint/cluster/link.h"
+#include "glint/cluster/mpi_transport.h"
 
 namespace glint::cluster {
 
 class Session {
  public:
-  // MPI_Init_thread asking for MPI_THREAD_SERIALIZED (only the link's thread calls MPI meanwhile),
-  // then the link: rank 0 watches every other rank, the others watch rank 0. The timeout is
-  // GLINT_MPI_TIMEOUT seconds when set (docs/distributed.md). Throws std::runtime_error when MPI
-  // cannot give that thread level.
+  // Loads the MPI module (mpi_transport.h), MPI_Init_thread asking for MPI_THREAD_SERIALIZED (only
+  // the link's thread calls MPI meanwhile), then the link: rank 0 watches every other rank, the
+  // others watch rank 0. The timeout is GLINT_MPI_TIMEOUT seconds when set (docs/distributed.md).
+  // Throws std::runtime_error when MPI cannot give that thread level or the module cannot be
+  // loaded.
   Session();
   // Without finish(): as finish(status, false).
   ~Session();
@@ -34,6 +36,7 @@ class Session {
   int finish(int status, bool orderly);
 
  private:
+  MpiTransport& mpi_;
   int rank_ = 0;
   int size_ = 1;
   std::string host_;

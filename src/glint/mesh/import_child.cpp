@@ -32,6 +32,7 @@
 
 #include "glint/core/cancel.h"
 #include "glint/core/file_access.h"
+#include "glint/core/helper_files.h"
 #include "glint/core/huge_pages.h"
 #include "glint/mesh/mesh_reader_wire.h"
 
@@ -231,34 +232,21 @@ namespace {
 // the other records cross as raw bytes) is that of one build, so a reader from another glint
 // version is refused.
 
-// The mesh reader program: GLINT_MESH_READER when set; else the first that exists of
-// glint-mesh-reader beside the running program (the build tree, a program linked with the
-// library), ../libexec/glint/ from it (an installed tree, wherever it was moved), the build tree
-// the library was built in, and the installed libexec folder. Empty when none is found.
+// The mesh reader program (core/helper_files.h): GLINT_MESH_READER when set, beside the running
+// program, ../libexec/glint from it, the build tree the library was built in, the installed
+// libexec folder.
 std::filesystem::path findMeshReader() {
-  namespace fs = std::filesystem;
-  if (const char* forced = std::getenv("GLINT_MESH_READER"); forced != nullptr && *forced != 0) {
-    return forced;
-  }
-  std::vector<fs::path> candidates;
-  std::error_code error;
-  const fs::path self = fs::read_symlink("/proc/self/exe", error);
-  if (!error) {
-    candidates.push_back(self.parent_path() / kMeshReaderProgram);
-    candidates.push_back(self.parent_path().parent_path() / "libexec/glint" / kMeshReaderProgram);
-  }
 #ifdef GLINT_MESH_READER_BUILD_PATH
-  candidates.emplace_back(GLINT_MESH_READER_BUILD_PATH);
+  constexpr std::string_view kBuildPath = GLINT_MESH_READER_BUILD_PATH;
+#else
+  constexpr std::string_view kBuildPath;
 #endif
 #ifdef GLINT_MESH_READER_INSTALL_PATH
-  candidates.emplace_back(GLINT_MESH_READER_INSTALL_PATH);
+  constexpr std::string_view kInstallPath = GLINT_MESH_READER_INSTALL_PATH;
+#else
+  constexpr std::string_view kInstallPath;
 #endif
-  for (const fs::path& candidate : candidates) {
-    if (fs::is_regular_file(candidate, error) && ::access(candidate.c_str(), X_OK) == 0) {
-      return candidate;
-    }
-  }
-  return {};
+  return findHelperFile(kMeshReaderProgram, "GLINT_MESH_READER", kBuildPath, kInstallPath, true);
 }
 
 // Found once per process.

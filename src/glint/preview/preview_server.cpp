@@ -2,7 +2,6 @@
 
 #include <arpa/inet.h>
 #include <fmt/format.h>
-#include <httplib.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -14,8 +13,9 @@
 #include <cstring>
 #include <span>
 #include <string_view>
-#include <thread>
 
+#include "glint/core/helper_files.h"
+#include "glint/preview/preview_http_module.h"
 #include "glint/preview/preview_messages.h"
 #include "preview_page.h"  // kPreviewPage: preview_page.html, embedded at build time
 
@@ -101,9 +101,24 @@ bool isLoopbackHost(std::string_view host) {
          PreviewServer::isLoopback(std::string(name));
 }
 
-void plainText(httplib::Response& res, int status, const std::string& text) {
-  res.status = status;
-  res.set_content(text + "\n", "text/plain; charset=utf-8");
+// The module's server (preview_http_module.h), loaded on the first preview of the process.
+preview_http::StartFunction loadServerModule() {
+#ifdef GLINT_PREVIEW_MODULE_BUILD_PATH
+  constexpr std::string_view kBuildPath = GLINT_PREVIEW_MODULE_BUILD_PATH;
+#else
+  constexpr std::string_view kBuildPath;
+#endif
+#ifdef GLINT_PREVIEW_MODULE_INSTALL_PATH
+  constexpr std::string_view kInstallPath = GLINT_PREVIEW_MODULE_INSTALL_PATH;
+#else
+  constexpr std::string_view kInstallPath;
+#endif
+  static std::string error;
+  static void* const start =
+      loadHelperModule(preview_http::kModuleFile, "GLINT_PREVIEW_MODULE", kBuildPath, kInstallPath,
+                       preview_http::kModuleIdentity, preview_http::kStartFunction, error);
+  if (start == nullptr) throw PreviewError("cannot start the preview: " + error);
+  return reinterpret_cast<preview_http::StartFunction>(start);
 }
 
 }  // namespace
@@ -115,92 +130,71 @@ struct PreviewServer::Impl {
   PreviewState& state;
   std::string address;
   int port = 0;
-  httplib::Server server;
-  std::thread listener;
+  std::unique_ptr<preview_http::Server> server;
   std::atomic<int> streams{0};
-  std::atomic<bool> listenerDone{false};
   bool stopped = false;
 
-  void route(bool loopback);
-  void stream(httplib::Response& res);
+  std::unique_ptr<preview_http::EventStream> openStream();
 };
 
-void PreviewServer::Impl::route(bool loopback) {
-  server.set_pre_routing_handler([loopback](const httplib::Request& req, httplib::Response& res) {
-    if (req.method != "GET") {
-      res.set_header("Allow", "GET");
-      plainText(res, 405, "method not allowed: the glint preview answers GET only");
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    if (loopback && !isLoopbackHost(req.get_header_value("Host"))) {
-      plainText(res, 403, "forbidden: this preview answers only to localhost addresses");
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    return httplib::Server::HandlerResponse::Unhandled;
-  });
-  server.set_post_routing_handler([](const httplib::Request&, httplib::Response& res) {
-    res.set_header("X-Content-Type-Options", "nosniff");
-    res.set_header("Referrer-Policy", "no-referrer");
-    res.set_header("Cache-Control", "no-store");
-  });
-  server.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
-    if (res.status == 404)
-      plainText(res, 404, fmt::format("not found: {} (the glint preview is at /)", req.path));
-  });
-  server.Get("/", [](const httplib::Request&, httplib::Response& res) {
-    res.set_header("Content-Security-Policy", kContentSecurityPolicy);
-    res.set_content(kPreviewPage, "text/html; charset=utf-8");
-  });
-  server.Get("/events", [this](const httplib::Request&, httplib::Response& res) { stream(res); });
-}
+namespace {
 
-void PreviewServer::Impl::stream(httplib::Response& res) {
+// One page's event stream: what changed in the PreviewState since it last looked, as server-sent
+// events, and a comment now and then to keep it open.
+class StateStream final : public preview_http::EventStream {
+ public:
+  StateStream(PreviewState& state, std::atomic<int>& streams) : state_(state), streams_(streams) {}
+  ~StateStream() override { streams_.fetch_sub(1); }
+
+  bool writeNext(const Write& sink) override {
+    if (state_.isClosed()) return false;
+    const PreviewChanges changes = state_.waitForChanges(version_, kStreamWait);
+    const auto now = Clock::now();
+    const auto write = [&](const std::string& text) {
+      lastWrite_ = now;
+      return sink(text);
+    };
+    if (!started_) {
+      started_ = true;
+      if (!write("retry: 1000\n\n")) return false;
+    }
+    // Pixels before the status: a page that reads "finished" already has the whole image.
+    const std::span<const PreviewTile> tiles(changes.tiles);
+    for (std::size_t i = 0; i < tiles.size(); i += kTilesPerEvent)
+      if (!write(tilesEvent(tiles.subspan(i, std::min(kTilesPerEvent, tiles.size() - i)),
+                            changes.status.width, changes.status.height)))
+        return false;
+    version_ = changes.version;
+    std::string status = statusEvent(changes.status);
+    const bool due =
+        changes.status.phase != PreviewPhase::Rendering || now - statusSent_ >= kStatusInterval;
+    if (status != lastStatus_ && due) {
+      if (!write(status)) return false;
+      lastStatus_ = std::move(status);
+      statusSent_ = now;
+    }
+    if (now - lastWrite_ >= kKeepAliveInterval && !write(": keep-alive\n\n")) return false;
+    return true;
+  }
+
+ private:
+  PreviewState& state_;
+  std::atomic<int>& streams_;
+  std::uint64_t version_ = 0;
+  std::string lastStatus_;
+  Clock::time_point statusSent_{};
+  Clock::time_point lastWrite_ = Clock::now();
+  bool started_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<preview_http::EventStream> PreviewServer::Impl::openStream() {
   if (streams.fetch_add(1) >= kMaxStreams) {
     streams.fetch_sub(1);
-    plainText(res, 503, "too many open preview pages; close one");
-    return;
+    return nullptr;
   }
-  struct Cursor {
-    std::uint64_t version = 0;
-    std::string lastStatus;
-    Clock::time_point statusSent{};
-    Clock::time_point lastWrite = Clock::now();
-    bool started = false;
-  };
-  res.set_chunked_content_provider(
-      "text/event-stream",
-      [this, cursor = Cursor{}](std::size_t, httplib::DataSink& sink) mutable {
-        if (state.isClosed()) return false;
-        const PreviewChanges changes = state.waitForChanges(cursor.version, kStreamWait);
-        const auto now = Clock::now();
-        const auto write = [&](const std::string& text) {
-          cursor.lastWrite = now;
-          return sink.write(text.data(), text.size());
-        };
-        if (!cursor.started) {
-          cursor.started = true;
-          if (!write("retry: 1000\n\n")) return false;
-        }
-        // Pixels before the status: a page that reads "finished" already has the whole image.
-        const std::span<const PreviewTile> tiles(changes.tiles);
-        for (std::size_t i = 0; i < tiles.size(); i += kTilesPerEvent)
-          if (!write(tilesEvent(tiles.subspan(i, std::min(kTilesPerEvent, tiles.size() - i)),
-                                changes.status.width, changes.status.height)))
-            return false;
-        cursor.version = changes.version;
-        std::string status = statusEvent(changes.status);
-        const bool due = changes.status.phase != PreviewPhase::Rendering ||
-                         now - cursor.statusSent >= kStatusInterval;
-        if (status != cursor.lastStatus && due) {
-          if (!write(status)) return false;
-          cursor.lastStatus = std::move(status);
-          cursor.statusSent = now;
-        }
-        if (now - cursor.lastWrite >= kKeepAliveInterval && !write(": keep-alive\n\n"))
-          return false;
-        return true;
-      },
-      [this](bool) { streams.fetch_sub(1); });
+  return std::make_unique<StateStream>(state, streams);
 }
 
 PreviewServer::PreviewServer(PreviewState& state, const std::string& address, int port)
@@ -212,31 +206,22 @@ PreviewServer::PreviewServer(PreviewState& state, const std::string& address, in
         address));
   if (port < 0 || port > 65535)
     throw PreviewError(fmt::format("the preview port must be from 0 to 65535, got {}", port));
-  httplib::Server& server = impl_->server;
-  // cpp-httplib's default sets SO_REUSEPORT, which would let a second glint listen on the same
-  // port; SO_REUSEADDR only allows a quick restart after a previous one ended.
-  server.set_socket_options([](int sock) {
-    const int yes = 1;
-    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-  });
-  server.new_task_queue = []() { return new httplib::ThreadPool(kServerThreads); };
-  server.set_keep_alive_max_count(20);
-  server.set_keep_alive_timeout(1);
-  server.set_read_timeout(5, 0);
-  server.set_write_timeout(5, 0);
-  server.set_payload_max_length(64 * 1024);
-  impl_->route(isLoopback(address));
-
-  const int bound = port == 0 ? server.bind_to_any_port(address)
-                              : (server.bind_to_port(address, port) ? port : -1);
-  if (bound < 0)
+  const preview_http::StartFunction start = loadServerModule();
+  preview_http::Settings settings;
+  settings.address = address;
+  settings.port = port;
+  settings.page = std::string_view(kPreviewPage, sizeof kPreviewPage - 1);
+  settings.contentSecurityPolicy = kContentSecurityPolicy;
+  settings.threads = kServerThreads;
+  settings.hostAllowed = [loopback = isLoopback(address)](std::string_view host) {
+    return !loopback || isLoopbackHost(host);
+  };
+  settings.openStream = [impl = impl_.get()]() { return impl->openStream(); };
+  impl_->server.reset(start(settings));
+  if (!impl_->server)
     throw PreviewError(fmt::format("cannot serve the preview on {}:{}: {}", address, port,
                                    bindFailure(address, family, port)));
-  impl_->port = bound;
-  impl_->listener = std::thread([this]() {
-    impl_->server.listen_after_bind();
-    impl_->listenerDone = true;
-  });
+  impl_->port = impl_->server->port();
 }
 
 PreviewServer::~PreviewServer() { stop(); }
@@ -253,10 +238,7 @@ void PreviewServer::stop() {
   if (impl_->stopped) return;
   impl_->stopped = true;
   impl_->state.close();
-  // stop() does nothing until the listener thread has started listening.
-  while (!impl_->server.is_running() && !impl_->listenerDone) std::this_thread::sleep_for(1ms);
-  impl_->server.stop();
-  impl_->listener.join();
+  impl_->server->stop();
 }
 
 bool PreviewServer::isLoopback(const std::string& address) {

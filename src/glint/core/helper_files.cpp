@@ -1,0 +1,73 @@
+#include "glint/core/helper_files.h"
+
+#include <dlfcn.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <system_error>
+#include <vector>
+
+namespace glint {
+
+std::filesystem::path findHelperFile(std::string_view name, const char* override,
+                                     std::string_view buildPath, std::string_view installPath,
+                                     bool executable) {
+  namespace fs = std::filesystem;
+  if (const char* forced = std::getenv(override); forced != nullptr && *forced != 0) return forced;
+  std::vector<fs::path> candidates;
+  std::error_code error;
+  const fs::path self = fs::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    candidates.push_back(self.parent_path() / name);
+    candidates.push_back(self.parent_path().parent_path() / "libexec/glint" / name);
+  }
+  if (!buildPath.empty()) candidates.emplace_back(buildPath);
+  if (!installPath.empty()) candidates.emplace_back(installPath);
+  for (const fs::path& candidate : candidates) {
+    if (fs::is_regular_file(candidate, error) &&
+        ::access(candidate.c_str(), executable ? X_OK : R_OK) == 0)
+      return candidate;
+  }
+  return {};
+}
+
+}  // namespace glint
+
+namespace glint {
+
+void* loadHelperModule(std::string_view name, const char* override, std::string_view buildPath,
+                       std::string_view installPath, const char* identity, const char* entry,
+                       std::string& error) {
+  const std::filesystem::path path =
+      findHelperFile(name, override, buildPath, installPath, /*executable=*/false);
+  if (path.empty()) {
+    error = fmt::format(
+        "{} was not found beside this program, in ../libexec/glint from it, or where glint was "
+        "built or installed (set {} to its path)",
+        name, override);
+    return nullptr;
+  }
+  // Never closed: its threads and the objects it made may live until the process ends.
+  void* const module = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (module == nullptr) {
+    const char* reason = ::dlerror();
+    error = fmt::format("cannot load {}: {}", path.string(), reason ? reason : "unknown reason");
+    return nullptr;
+  }
+  using IdentityFunction = const char* (*)();
+  const auto moduleIdentity =
+      reinterpret_cast<IdentityFunction>(::dlsym(module, "glint_module_identity"));
+  if (moduleIdentity == nullptr || std::string_view(moduleIdentity()) != identity) {
+    error = fmt::format("{} is not the module of this glint ({}; expected '{}')", path.string(),
+                        moduleIdentity ? fmt::format("it is '{}'", moduleIdentity())
+                                       : std::string("it has no glint module identity"),
+                        identity);
+    return nullptr;
+  }
+  void* const function = ::dlsym(module, entry);
+  if (function == nullptr) error = fmt::format("{} has no entry point {}", path.string(), entry);
+  return function;
+}
+
+}  // namespace glint

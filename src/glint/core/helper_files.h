@@ -1,0 +1,40 @@
+// Where glint's helper files are found: the programs and modules it starts or loads on demand
+// (the mesh reader, the preview server, the MPI transport), wherever glint was built, installed or
+// moved to.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace glint {
+
+// The helper `name`: the path in environment variable `override` when it is set and not empty
+// (returned whether or not it exists, so that a wrong setting is reported as such); else the first
+// regular file that exists of: `name` beside the running program (a build tree, a program linked
+// with the library), ../libexec/glint/`name` from it (an installed tree, wherever it was moved),
+// `buildPath` and `installPath` (either may be empty). Empty when none is found. `executable`:
+// whether it must be executable (a program, not a module).
+std::filesystem::path findHelperFile(std::string_view name, const char* override,
+                                     std::string_view buildPath, std::string_view installPath,
+                                     bool executable);
+
+}  // namespace glint
+
+namespace glint {
+
+// Every module glint loads answers `glint_module_identity()` with this text for its name and
+// interface version; a module of another glint version, another module or another interface is
+// refused (its classes would not match the caller's).
+#define GLINT_MODULE_IDENTITY(module, interface) \
+  ("glint " GLINT_VERSION " module " module " interface " #interface)
+
+// A module (a shared object of this build) loaded on demand: found as findHelperFile says, opened
+// with dlopen (RTLD_NOW: every symbol resolved now, not at a first call in a server thread),
+// checked against `identity`, and `entry` looked up. Returns the entry point, or nullptr with the
+// reason in `error`, worded for the user. The module stays loaded until the process ends.
+void* loadHelperModule(std::string_view name, const char* override, std::string_view buildPath,
+                       std::string_view installPath, const char* identity, const char* entry,
+                       std::string& error);
+
+}  // namespace glint
