@@ -2,7 +2,7 @@
 #   bin/glint                                the command            (component runtime)
 #   libexec/glint/glint-mesh-reader          reads mesh files for glint and the library (runtime)
 #   libexec/glint/glint-*.so                 modules loaded on demand: the preview's HTTP server,
-#                                            the MPI transport (runtime)
+#                                            OpenEXR, the MPI transport (runtime)
 #   lib/libglint.a, include/glint/           the library, headers   (component dev)
 #   lib/cmake/glint/                         find_package(glint CONFIG) -> glint::glint (dev)
 # `cpack --config build/CPackConfig.cmake` makes two .debs: glint (the command; its Depends from
@@ -13,7 +13,7 @@ include(CMakePackageConfigHelpers)
 install(TARGETS glint_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 install(TARGETS glint_mesh_reader RUNTIME DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/glint
         COMPONENT runtime)
-install(TARGETS glint_preview_http LIBRARY DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/glint
+install(TARGETS glint_preview_http glint_exr LIBRARY DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/glint
         COMPONENT runtime)
 if(TARGET glint_mpi)
   install(TARGETS glint_mpi LIBRARY DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/glint
@@ -60,5 +60,5 @@ find_package(glint CONFIG) gives the target glint::glint.")
 # What glintConfig.cmake finds (find_dependency, pkg-config), as Debian packages.
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
     "glint (= ${PROJECT_VERSION}), cmake, pkg-config, libtbb-dev, libfmt-dev, libpng-dev, \
-libjpeg62-turbo-dev, libopenexr-dev, libassimp-dev, libyaml-dev")
+libjpeg62-turbo-dev, libassimp-dev, libyaml-dev")
 include(CPack)

@@ -359,6 +359,23 @@ TEST_F(Cli, MissingOutputFolderExitsTwo) {
   EXPECT_TRUE(filesIn(work_).empty());
 }
 
+// OpenEXR is a module (glint-exr.so, beside glint in the build tree) loaded on demand: when it
+// cannot be loaded, an EXR output fails before the render, and an EXR texture is refused at its
+// line; other outputs do not need it.
+TEST_F(Cli, AnExrModuleThatCannotLoadFailsBeforeTheRender) {
+  const std::string missing = (work_ / "no-such-module.so").string();
+  ASSERT_EQ(::setenv("GLINT_EXR_MODULE", missing.c_str(), 1), 0);
+  const RunResult exr = run({"render", small(), "-o", "out.exr"});
+  const RunResult png = run({"render", small(), "-o", "out.png", "--quiet"});
+  ::unsetenv("GLINT_EXR_MODULE");
+  EXPECT_EQ(exr.status, 1) << exr.err;
+  EXPECT_TRUE(contains(exr.err, "cannot write 'out.exr': cannot load " + missing)) << exr.err;
+  EXPECT_FALSE(contains(exr.err, "%")) << "it rendered first: " << exr.err;
+  EXPECT_FALSE(fs::exists(work_ / "out.exr"));
+  EXPECT_EQ(png.status, 0) << png.err;
+  EXPECT_TRUE(fs::exists(work_ / "out.png"));
+}
+
 TEST_F(Cli, OutputPathThatIsAFolderIsAWriteFailure) {
   fs::create_directory(work_ / "out.png");
   const RunResult r = run({"render", small(), "-o", "out.png"});

@@ -38,8 +38,10 @@ dev_files="$(dpkg-deb -c "$dev")"
 grep -q '\./usr/bin/glint$' <<<"$runtime_files" || fail "no /usr/bin/glint in the package"
 grep -q '\./usr/libexec/glint/glint-mesh-reader$' <<<"$runtime_files" ||
   fail "no /usr/libexec/glint/glint-mesh-reader in the package"
-grep -q '\./usr/libexec/glint/glint-preview-http\.so$' <<<"$runtime_files" ||
-  fail "no /usr/libexec/glint/glint-preview-http.so in the package"
+for module in glint-preview-http.so glint-exr.so; do
+  grep -q "\./usr/libexec/glint/$module\$" <<<"$runtime_files" ||
+    fail "no /usr/libexec/glint/$module in the package"
+done
 if [[ -f "$build/glint-mpi.so" ]]; then
   grep -q '\./usr/libexec/glint/glint-mpi\.so$' <<<"$runtime_files" ||
     fail "no /usr/libexec/glint/glint-mpi.so in the package"
@@ -56,6 +58,9 @@ dpkg-deb -x "$runtime" "$work/root"
 # A mesh scene: the unpacked glint reads its mesh with the unpacked reader (../libexec/glint).
 "$work/root/usr/bin/glint" render "$source/scenes/mesh.yaml" -o "$work/mesh.png" --quiet
 [[ -s "$work/mesh.png" ]] || fail "the unpacked glint did not render a mesh scene"
+# An EXR image: the unpacked glint loads the unpacked OpenEXR module.
+"$work/root/usr/bin/glint" render "$source/tests/cli/small.yaml" -o "$work/small.exr" --quiet ||
+  fail "the unpacked glint could not write an EXR image"
 # A preview: the unpacked glint loads the unpacked HTTP module (../libexec/glint).
 "$work/root/usr/bin/glint" render "$source/tests/cli/small.yaml" -o "$work/previewed.png" \
   --preview 0 --preview-linger 0 2>"$work/preview.log" ||

@@ -34,8 +34,12 @@ archive="$(find "$prefix" -name libglint.a)"
 "$build/glint" render "$source/scenes/mesh.yaml" -o "$work/mesh-in-tree.png" --quiet
 cmp "$work/mesh.png" "$work/mesh-in-tree.png" ||
   fail "the installed glint renders scenes/mesh.yaml other than the build tree's"
-[[ -f "$prefix/libexec/glint/glint-preview-http.so" ]] ||
-  fail "no libexec/glint/glint-preview-http.so"
+for module in glint-preview-http.so glint-exr.so; do
+  [[ -f "$prefix/libexec/glint/$module" ]] || fail "no libexec/glint/$module"
+done
+# An EXR image from the installed command, with the installed OpenEXR module.
+"$prefix/bin/glint" render "$source/tests/cli/small.yaml" -o "$work/small.exr" --quiet ||
+  fail "the installed glint could not write an EXR image"
 if [[ -f "$build/glint-mpi.so" ]]; then
   [[ -f "$prefix/libexec/glint/glint-mpi.so" ]] || fail "no libexec/glint/glint-mpi.so"
 fi

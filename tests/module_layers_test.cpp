@@ -7,8 +7,8 @@
 //   (above job: it hooks the job's render step, and the job must not know MPI); preview serves a
 //   running job's picture over HTTP (it consumes job events, so it sits above job); cli only turns
 //   arguments into jobs; mesh_reader (the glint-mesh-reader program) runs mesh's import child;
-//   modules (the shared objects glint loads on demand) implement an interface header of preview
-//   or cluster and may include nothing more of glint than those and core;
+//   modules (the shared objects glint loads on demand) implement an interface header of image,
+//   preview or cluster and may include nothing more of glint than those and core;
 //   glint/glint.h, the umbrella header, includes the public API of every
 //   module but cluster (built only with MPI).
 // Tests (*_test.cpp) may use anything.
@@ -48,7 +48,7 @@ const std::map<std::string, std::set<std::string>>& allowedModules() {
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
         "writers", "job", "preview"}},
       {"mesh_reader", {"core", "geometry", "accel", "scene", "readers", "mesh", "mesh_reader"}},
-      {"modules", {"core", "preview", "cluster", "modules"}},
+      {"modules", {"core", "image", "preview", "cluster", "modules"}},
       {"cli",
        {"core", "geometry", "accel", "scene", "render", "readers", "mesh", "image", "factories",
         "writers", "job", "cluster", "preview", "cli"}},

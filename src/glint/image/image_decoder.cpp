@@ -5,8 +5,6 @@
 #include <png.h>
 #include <unistd.h>
 
-#include <ImfIO.h>
-#include <ImfRgbaFile.h>
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -22,6 +20,7 @@
 
 #include "glint/core/color.h"
 #include "glint/core/file_access.h"
+#include "glint/image/exr_module.h"
 
 namespace glint {
 
@@ -207,65 +206,16 @@ RgbImage decodeJpeg(std::span<const std::uint8_t> bytes, const ImageHeader& head
   return image;
 }
 
-// --- EXR (OpenEXR's RGBA interface over memory) --------------------------------------------------
-
-class MemoryStream : public Imf::IStream {
- public:
-  explicit MemoryStream(std::span<const std::uint8_t> bytes)
-      : Imf::IStream("texture"), bytes_(bytes) {}
-  bool read(char c[], int n) override {
-    if (n < 0 || static_cast<std::uint64_t>(n) > bytes_.size() - at_) {
-      throw ImageReadError("invalid EXR file: it is cut short");
-    }
-    std::memcpy(c, bytes_.data() + at_, static_cast<std::size_t>(n));
-    at_ += static_cast<std::uint64_t>(n);
-    return at_ < bytes_.size();
-  }
-  std::uint64_t tellg() override { return at_; }
-  void seekg(std::uint64_t pos) override {
-    if (pos > bytes_.size())
-      throw ImageReadError("invalid EXR file: an offset points past its end");
-    at_ = pos;
-  }
-
- private:
-  std::span<const std::uint8_t> bytes_;
-  std::uint64_t at_ = 0;
-};
+// --- EXR (OpenEXR's RGBA interface over memory, in the module exr_module.h) ---------------------
 
 RgbImage decodeExr(std::span<const std::uint8_t> bytes, const ImageHeader& header) {
-  try {
-    MemoryStream stream(bytes);
-    Imf::RgbaInputFile file(stream, 1);
-    const Imath::Box2i window = file.dataWindow();
-    const std::int64_t width = std::int64_t{window.max.x} - window.min.x + 1;
-    const std::int64_t height = std::int64_t{window.max.y} - window.min.y + 1;
-    if (width != header.width || height != header.height) {
-      throw ImageReadError("invalid EXR file: its size is inconsistent");
-    }
-    std::vector<Imf::Rgba> pixels(static_cast<std::size_t>(width * height));
-    // The frame buffer is addressed from the data window's origin.
-    Imf::Rgba* base =
-        pixels.data() - (std::int64_t{window.min.x} + std::int64_t{window.min.y} * width);
-    file.setFrameBuffer(base, 1, static_cast<std::size_t>(width));
-    file.readPixels(window.min.y, window.max.y);
-    RgbImage image = emptyImage(header);
-    for (std::size_t i = 0; i < pixels.size(); ++i) {
-      const float rgb[3] = {pixels[i].r, pixels[i].g, pixels[i].b};
-      for (int c = 0; c < 3; ++c) {
-        // Textures hold finite radiance ≥ 0; NaN and infinity become 0.
-        const float v = rgb[c];
-        image.pixels[3 * i + static_cast<std::size_t>(c)] = std::isfinite(v) && v > 0 ? v : 0.0f;
-      }
-    }
-    return image;
-  } catch (const ImageReadError&) {
-    throw;
-  } catch (const std::bad_alloc&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw ImageReadError(fmt::format("invalid EXR file: {}", e.what()));
-  }
+  std::string error;
+  exr_module::Codec* const codec = exr_module::exrCodec(error);
+  if (codec == nullptr) throw ImageReadError("cannot read EXR files: " + error);
+  RgbImage image{static_cast<int>(header.width), static_cast<int>(header.height), {}};
+  error = codec->decode(bytes, header.width, header.height, image.pixels);
+  if (!error.empty()) throw ImageReadError(error);
+  return image;
 }
 
 // --- Radiance HDR (RGBE with the "new" run-length scanlines of Greg Ward's format) --------------

@@ -2,10 +2,6 @@
 // writing row by row so that a cancel stops it within a row.
 #include "glint/image/image_writer.h"
 
-#include <ImfChannelList.h>
-#include <ImfFrameBuffer.h>
-#include <ImfHeader.h>
-#include <ImfOutputFile.h>
 #include <png.h>
 
 #include <algorithm>
@@ -24,6 +20,7 @@
 #include "glint/core/atomic_file.h"
 #include "glint/core/cancel.h"
 #include "glint/image/channel_encoder.h"
+#include "glint/image/exr_module.h"
 
 namespace glint {
 
@@ -237,6 +234,11 @@ constexpr int kExrRowsPerCall = 64;
 // Linear half of the pipeline: the film's values as 32-bit floats, unclamped, no encoding.
 class ExrWriter final : public ImageWriter {
  public:
+  std::string unavailable() const override {
+    std::string error;
+    return exr_module::exrCodec(error) != nullptr ? std::string() : error;
+  }
+
   void write(const Film& film, const std::filesystem::path& path, Encoding,
              const WriteControl& control) const override {
     requireNonEmpty(film, path);
@@ -255,43 +257,34 @@ class ExrWriter final : public ImageWriter {
         blue[i] = static_cast<float>(c.b);
       }
     }
+    std::string error;
+    exr_module::Codec* const codec = exr_module::exrCodec(error);
+    if (codec == nullptr) fail(path, error);
     TemporaryImage temp(path);
     temp.close();                      // reserves the unique name; OpenEXR reopens it by path
     std::exception_ptr callbackError;  // rethrown as it is, not as an OpenEXR error
-    try {
-      Imf::Header header(width, height);
-      header.channels().insert("R", Imf::Channel(Imf::FLOAT));
-      header.channels().insert("G", Imf::Channel(Imf::FLOAT));
-      header.channels().insert("B", Imf::Channel(Imf::FLOAT));
-      Imf::FrameBuffer frame;
-      const std::size_t xStride = sizeof(float);
-      const std::size_t yStride = sizeof(float) * static_cast<std::size_t>(width);
-      frame.insert("R",
-                   Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(red.data()), xStride, yStride));
-      frame.insert("G",
-                   Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(green.data()), xStride, yStride));
-      frame.insert("B",
-                   Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(blue.data()), xStride, yStride));
-      Imf::OutputFile out(temp.path().c_str(), header);
-      out.setFrameBuffer(frame);
-      // writePixels(n) writes the next n rows of the frame buffer.
-      for (int y = 0; y < height; y += kExrRowsPerCall) {
-        throwIfCancelled(control.cancel);
-        const int rows = std::min(kExrRowsPerCall, height - y);
-        out.writePixels(rows);
-        if (!control.rowWritten) continue;
+    bool cancelled = false;
+    // After each call: the caller's callback, then the cancel flag (polled before every call;
+    // before the first, above).
+    const auto rowsWritten = [&](int rows) {
+      if (control.rowWritten) {
         try {
-          control.rowWritten(y + rows, height);
+          control.rowWritten(rows, height);
         } catch (...) {
           callbackError = std::current_exception();
-          break;
+          return false;
         }
       }
-    } catch (const Cancelled&) {
-      throw;
-    } catch (const std::exception& e) {
-      fail(path, std::string("OpenEXR error: ") + e.what());
-    }
+      if (rows < height && isCancelled(control.cancel)) {
+        cancelled = true;
+        return false;
+      }
+      return true;
+    };
+    error = codec->write(temp.path().c_str(), width, height, red.data(), green.data(), blue.data(),
+                         kExrRowsPerCall, rowsWritten);
+    if (!error.empty()) fail(path, "OpenEXR error: " + error);
+    if (cancelled) throw Cancelled();
     if (callbackError) std::rethrow_exception(callbackError);
     temp.commit();
   }

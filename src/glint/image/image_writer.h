@@ -42,6 +42,9 @@ class ImageWriter {
   // Writes film to `path` (complete file, then rename). Throws ImageWriteError, or Cancelled.
   virtual void write(const Film& film, const std::filesystem::path& path, Encoding encoding,
                      const WriteControl& control) const = 0;
+  // Empty when the writer can write; else why not (its module cannot be loaded), worded for the
+  // user — asked before a render, so that the failure comes before the work.
+  virtual std::string unavailable() const { return {}; }
 };
 
 // The writer for path's extension (.png, .ppm, .exr; case-insensitive), or nullptr if unknown.

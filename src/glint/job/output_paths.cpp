@@ -37,7 +37,8 @@ fs::path defaultOutputPath(const fs::path& scene) { return scene.stem().concat("
 
 void checkOutputPath(const fs::path& out, const fs::path& scene,
                      const std::optional<fs::path>& resume) {
-  if (!writerForPath(out)) {
+  const std::unique_ptr<ImageWriter> writer = writerForPath(out);
+  if (!writer) {
     const std::string extension = out.extension().string();
     throw JobError(JobFailure::BadInput,
                    fmt::format("cannot write '{}': {}; use .png, .ppm or .exr", out.string(),
@@ -65,6 +66,8 @@ void checkOutputPath(const fs::path& out, const fs::path& scene,
     throw JobError(JobFailure::Failure,
                    fmt::format("cannot write '{}': the folder '{}' is not writable", out.string(),
                                folder.string()));
+  if (const std::string why = writer->unavailable(); !why.empty())
+    throw JobError(JobFailure::Failure, fmt::format("cannot write '{}': {}", out.string(), why));
 }
 
 std::optional<fs::path> resolveCheckpointPath(const std::optional<fs::path>& checkpoint,
