@@ -4,6 +4,7 @@
 
 #include <emmintrin.h>
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/task_group.h>
 
@@ -409,8 +410,18 @@ std::uint32_t buildNode(std::vector<BuildItem>& items, const Range& range, const
     }
     if (pick < 0) break;
     const auto [left, right] = split(items, children[pick]);
-    children[pick] = {left, decide(items, left, depth + 1, pickLeaf)};
-    children[childCount++] = {right, decide(items, right, depth + 1, pickLeaf)};
+    Decision leftDecision, rightDecision;
+    if (range.count() >= kParallelBuildThreshold) {
+      // The halves' decisions read disjoint items: side by side, so that the node's own splits
+      // (serial, before its subtrees become tasks) keep both threads busy.
+      tbb::parallel_invoke([&] { leftDecision = decide(items, left, depth + 1, pickLeaf); },
+                           [&] { rightDecision = decide(items, right, depth + 1, pickLeaf); });
+    } else {
+      leftDecision = decide(items, left, depth + 1, pickLeaf);
+      rightDecision = decide(items, right, depth + 1, pickLeaf);
+    }
+    children[pick] = {left, leftDecision};
+    children[childCount++] = {right, rightDecision};
   }
 
   const auto nodeIndex = static_cast<std::uint32_t>(out.size());
