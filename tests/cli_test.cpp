@@ -374,6 +374,29 @@ TEST_F(Cli, AnExrModuleThatCannotLoadFailsBeforeTheRender) {
   EXPECT_FALSE(fs::exists(work_ / "out.exr"));
   EXPECT_EQ(png.status, 0) << png.err;
   EXPECT_TRUE(fs::exists(work_ / "out.png"));
+
+  // An EXR texture: read through the module when it is there, refused at its line when not.
+  ASSERT_EQ(run({"render", small(), "-o", "texture.exr", "--quiet"}).status, 0);
+  writeFile(work_ / "textured.yaml",
+            "name: textured\n"
+            "camera: { position: [0, 0, 3], look_at: [0, 0, 0], up: [0, 1, 0], fov: 40 }\n"
+            "image: { width: 16, height: 12 }\n"
+            "textures:\n"
+            "  picture: { type: image, file: texture.exr }\n"
+            "objects:\n"
+            "  - { type: sphere, center: [0, 0, 0], radius: 1, material: { kd: picture } }\n"
+            "lights:\n"
+            "  - { type: point, position: [2, 2, 3], color: [1, 1, 1], intensity: 1 }\n");
+  EXPECT_EQ(run({"render", "textured.yaml", "-o", "textured.png", "--quiet"}).status, 0);
+  ASSERT_EQ(::setenv("GLINT_EXR_MODULE", missing.c_str(), 1), 0);
+  const RunResult texture = run({"render", "textured.yaml", "-o", "refused.png"});
+  ::unsetenv("GLINT_EXR_MODULE");
+  EXPECT_EQ(texture.status, 2) << texture.err;
+  EXPECT_TRUE(contains(texture.err, "textured.yaml:5:")) << texture.err;
+  EXPECT_TRUE(contains(texture.err, "cannot read EXR files: cannot load " + missing +
+                                        ": cannot open shared object file"))
+      << texture.err;
+  EXPECT_FALSE(fs::exists(work_ / "refused.png"));
 }
 
 TEST_F(Cli, OutputPathThatIsAFolderIsAWriteFailure) {

@@ -51,8 +51,13 @@ void* loadHelperModule(std::string_view name, const char* override, std::string_
   // Never closed: its threads and the objects it made may live until the process ends.
   void* const module = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (module == nullptr) {
-    const char* reason = ::dlerror();
-    error = fmt::format("cannot load {}: {}", path.string(), reason ? reason : "unknown reason");
+    const char* const failure = ::dlerror();  // clears it: read once
+    std::string_view reason = failure != nullptr ? failure : "";
+    // dlerror() names the file itself: "PATH: cannot open shared object file: ...".
+    const std::string prefix = path.string() + ": ";
+    if (reason.starts_with(prefix)) reason.remove_prefix(prefix.size());
+    error = fmt::format("cannot load {}: {}", path.string(),
+                        reason.empty() ? std::string_view("unknown reason") : reason);
     return nullptr;
   }
   using IdentityFunction = const char* (*)();
