@@ -409,7 +409,10 @@ std::uint32_t buildNode(std::vector<BuildItem>& items, const Range& range, const
       }
     }
     if (pick < 0) break;
-    const auto [left, right] = split(items, children[pick]);
+    // Named references, not a structured binding: clang 14 cannot capture those in lambdas.
+    const std::pair<Range, Range> halves = split(items, children[pick]);
+    const Range& left = halves.first;
+    const Range& right = halves.second;
     Decision leftDecision, rightDecision;
     if (range.count() >= kParallelBuildThreshold) {
       // The halves' decisions read disjoint items: side by side, so that the node's own splits
