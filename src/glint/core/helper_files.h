@@ -9,6 +9,20 @@
 
 namespace glint {
 
+// The helper's path in this build tree and once installed, for the source file that finds it:
+// src/CMakeLists.txt (glint_helper_paths) defines GLINT_HELPER_BUILD_PATH and
+// GLINT_HELPER_INSTALL_PATH for it; empty where they are not defined.
+#ifdef GLINT_HELPER_BUILD_PATH
+#define GLINT_HELPER_BUILD_PATH_OR_EMPTY GLINT_HELPER_BUILD_PATH
+#else
+#define GLINT_HELPER_BUILD_PATH_OR_EMPTY ""
+#endif
+#ifdef GLINT_HELPER_INSTALL_PATH
+#define GLINT_HELPER_INSTALL_PATH_OR_EMPTY GLINT_HELPER_INSTALL_PATH
+#else
+#define GLINT_HELPER_INSTALL_PATH_OR_EMPTY ""
+#endif
+
 // The helper `name`: the path in environment variable `override` when it is set and not empty
 // (returned whether or not it exists, so that a wrong setting is reported as such); else the first
 // regular file that exists of: `name` beside the running program (a build tree, a program linked

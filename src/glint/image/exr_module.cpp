@@ -5,20 +5,10 @@
 namespace glint::exr_module {
 
 Codec* exrCodec(std::string& error) {
-#ifdef GLINT_EXR_MODULE_BUILD_PATH
-  constexpr std::string_view kBuildPath = GLINT_EXR_MODULE_BUILD_PATH;
-#else
-  constexpr std::string_view kBuildPath;
-#endif
-#ifdef GLINT_EXR_MODULE_INSTALL_PATH
-  constexpr std::string_view kInstallPath = GLINT_EXR_MODULE_INSTALL_PATH;
-#else
-  constexpr std::string_view kInstallPath;
-#endif
   static std::string loadError;
-  static void* const entry =
-      loadHelperModule(kModuleFile, "GLINT_EXR_MODULE", kBuildPath, kInstallPath, kModuleIdentity,
-                       kCodecFunction, loadError);
+  static void* const entry = loadHelperModule(
+      kModuleFile, "GLINT_EXR_MODULE", GLINT_HELPER_BUILD_PATH_OR_EMPTY,
+      GLINT_HELPER_INSTALL_PATH_OR_EMPTY, kModuleIdentity, kCodecFunction, loadError);
   if (entry == nullptr) {
     error = loadError;
     return nullptr;

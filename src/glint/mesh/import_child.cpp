@@ -236,17 +236,8 @@ namespace {
 // program, ../libexec/glint from it, the build tree the library was built in, the installed
 // libexec folder.
 std::filesystem::path findMeshReader() {
-#ifdef GLINT_MESH_READER_BUILD_PATH
-  constexpr std::string_view kBuildPath = GLINT_MESH_READER_BUILD_PATH;
-#else
-  constexpr std::string_view kBuildPath;
-#endif
-#ifdef GLINT_MESH_READER_INSTALL_PATH
-  constexpr std::string_view kInstallPath = GLINT_MESH_READER_INSTALL_PATH;
-#else
-  constexpr std::string_view kInstallPath;
-#endif
-  return findHelperFile(kMeshReaderProgram, "GLINT_MESH_READER", kBuildPath, kInstallPath, true);
+  return findHelperFile(kMeshReaderProgram, "GLINT_MESH_READER", GLINT_HELPER_BUILD_PATH_OR_EMPTY,
+                        GLINT_HELPER_INSTALL_PATH_OR_EMPTY, true);
 }
 
 // Found once per process.

@@ -103,19 +103,10 @@ bool isLoopbackHost(std::string_view host) {
 
 // The module's server (preview_http_module.h), loaded on the first preview of the process.
 preview_http::StartFunction loadServerModule() {
-#ifdef GLINT_PREVIEW_MODULE_BUILD_PATH
-  constexpr std::string_view kBuildPath = GLINT_PREVIEW_MODULE_BUILD_PATH;
-#else
-  constexpr std::string_view kBuildPath;
-#endif
-#ifdef GLINT_PREVIEW_MODULE_INSTALL_PATH
-  constexpr std::string_view kInstallPath = GLINT_PREVIEW_MODULE_INSTALL_PATH;
-#else
-  constexpr std::string_view kInstallPath;
-#endif
   static std::string error;
   static void* const start =
-      loadHelperModule(preview_http::kModuleFile, "GLINT_PREVIEW_MODULE", kBuildPath, kInstallPath,
+      loadHelperModule(preview_http::kModuleFile, "GLINT_PREVIEW_MODULE",
+                       GLINT_HELPER_BUILD_PATH_OR_EMPTY, GLINT_HELPER_INSTALL_PATH_OR_EMPTY,
                        preview_http::kModuleIdentity, preview_http::kStartFunction, error);
   if (start == nullptr) throw PreviewError("cannot start the preview: " + error);
   return reinterpret_cast<preview_http::StartFunction>(start);
