@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -47,6 +48,10 @@ class AtomicFile {
   std::filesystem::path path_;
   int fd_ = -1;
   std::FILE* stream_ = nullptr;
+  // stream()'s buffer: glibc's setvbuf ignores the size it is given without a buffer (it keeps
+  // st_blksize, 4 KiB), so the stream gets one of its own, freed with this object after the
+  // stream is closed (by close() or by the destructor's body).
+  std::unique_ptr<char[]> streamBuffer_;
   bool committed_ = false;
 };
 

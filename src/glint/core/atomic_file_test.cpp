@@ -1,6 +1,7 @@
 #include "glint/core/atomic_file.h"
 
 #include <gtest/gtest.h>
+#include <stdio_ext.h>
 #include <stdlib.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -67,6 +68,23 @@ TEST_F(AtomicFileTest, CommitReplacesTheTargetAndLeavesNothingElse) {
   file.commit();
   EXPECT_EQ(read(folder_ / "out.bin"), "new bytes");
   EXPECT_EQ(files(), std::set<std::string>{"out.bin"});
+}
+
+// Images go through stream() in 256 KiB writes: nothing reaches the file until the buffer is full
+// or the stream is flushed (glibc's setvbuf without a buffer of our own would keep 4 KiB).
+TEST_F(AtomicFileTest, TheStreamWritesInQuarterMebibyteBlocks) {
+  AtomicFile file(folder_ / "out.bin");
+  std::FILE* stream = file.stream();
+  EXPECT_EQ(__fbufsize(stream), std::size_t{1} << 18);
+  const std::string block(100'000, 'x');
+  ASSERT_EQ(std::fwrite(block.data(), 1, block.size(), stream), block.size());
+  EXPECT_EQ(std::filesystem::file_size(file.temporaryPath()), 0u) << "still in the buffer";
+  ASSERT_EQ(std::fwrite(block.data(), 1, block.size(), stream), block.size());
+  ASSERT_EQ(std::fwrite(block.data(), 1, block.size(), stream), block.size());
+  EXPECT_EQ(std::filesystem::file_size(file.temporaryPath()), std::size_t{1} << 18)
+      << "one full buffer written";
+  file.commit();
+  EXPECT_EQ(std::filesystem::file_size(folder_ / "out.bin"), 300'000u);
 }
 
 TEST_F(AtomicFileTest, AnUncommittedFileIsRemoved) {
