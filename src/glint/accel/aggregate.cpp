@@ -28,6 +28,7 @@
 
 #include "glint/accel/instances.h"
 #include "glint/accel/slab_test.h"
+#include "glint/core/huge_pages.h"
 #include "glint/core/ulp.h"
 #include "glint/geometry/sphere_intersection.h"
 
@@ -317,7 +318,7 @@ Aggregate::Aggregate(std::vector<Primitive> primitives, std::vector<Color> primi
 
   // One build reference per bounded primitive and per non-degenerate triangle. Triangle references
   // are made in parallel at fixed slots, then the dropped ones are squeezed out in order.
-  std::vector<bvh::BuildItem> items(references);
+  bvh::BuildItems items(references);
   std::size_t itemCount = 0;
   for (std::uint32_t i = 0; i < primitives_.size(); ++i) {
     const Primitive& p = primitives_[i];
@@ -390,7 +391,7 @@ Aggregate::Aggregate(std::vector<Primitive> primitives, std::vector<Color> primi
   nodeWidth_ = wide ? 8 : 4;
   if (wide && rootInfo_ == kInner) {
     wideNodes_ = bvh::collapseToWide(nodes_);
-    std::vector<Node>().swap(nodes_);
+    bvh::Nodes().swap(nodes_);
     rootChild_ = 0;
   }
 }
@@ -418,10 +419,10 @@ int Aggregate::nodeWidth() const { return nodeWidth_; }
 // reference array for triangles), and renumbering the vertices by first use in that order puts a
 // leaf's positions and normals next to each other. Values are moved, never recomputed, so every hit
 // is bit for bit what it was.
-void Aggregate::storeInLeafOrder(const std::vector<bvh::BuildItem>& items) {
+void Aggregate::storeInLeafOrder(const bvh::BuildItems& items) {
   const std::size_t n = items.size();
   // Per item (in leaf order): its slot in leafRefs_ (primitives) or its new triangle index.
-  std::vector<std::uint32_t> slot(n);
+  HugePageArray<std::uint32_t> slot(n);
   std::vector<std::uint32_t> meshTriangles(meshes_.size(), 0);
   std::uint32_t primitiveRefs = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -429,11 +430,12 @@ void Aggregate::storeInLeafOrder(const std::vector<bvh::BuildItem>& items) {
     slot[i] = key == kPrimitiveKey ? primitiveRefs++ : meshTriangles[key]++;
   }
   leafRefs_.assign(primitiveRefs, 0);
-  std::vector<std::vector<std::uint32_t>> oldTriangle(meshes_.size());
+  std::vector<HugePageArray<std::uint32_t>> oldTriangle(meshes_.size());
   for (std::size_t m = 0; m < meshes_.size(); ++m) oldTriangle[m].resize(meshTriangles[m]);
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t key = bvh::itemKey(items[i]);
-    (key == kPrimitiveKey ? leafRefs_ : oldTriangle[key])[slot[i]] = bvh::itemIndex(items[i]);
+    std::uint32_t& to = key == kPrimitiveKey ? leafRefs_[slot[i]] : oldTriangle[key][slot[i]];
+    to = bvh::itemIndex(items[i]);
   }
   leafSpheres_.assign(primitiveRefs, LeafSphere{});
   for (std::size_t k = 0; k < leafRefs_.size(); ++k) {
@@ -448,14 +450,14 @@ void Aggregate::storeInLeafOrder(const std::vector<bvh::BuildItem>& items) {
     }
   }
   if (bvh::isLeaf(rootInfo_)) rootChild_ = slot[rootChild_];
-  std::vector<std::uint32_t>().swap(slot);
+  HugePageArray<std::uint32_t>().swap(slot);
 
   tbb::parallel_for(std::size_t{0}, meshes_.size(), [&](std::size_t m) {
     TriangleMesh& mesh = meshes_[m];
-    const std::vector<std::uint32_t>& order = oldTriangle[m];
+    const HugePageArray<std::uint32_t>& order = oldTriangle[m];
     constexpr std::uint32_t kUnused = 0xffffffffu;
-    std::vector<std::uint32_t> vertexOf(mesh.positions.size(), kUnused);
-    std::vector<std::uint32_t> indices(3 * order.size());
+    HugePageArray<std::uint32_t> vertexOf(mesh.positions.size(), kUnused);
+    std::vector<std::uint32_t> indices = hugePageVector<std::uint32_t>(3 * order.size());
     std::uint32_t vertices = 0;
     for (std::size_t t = 0; t < order.size(); ++t) {
       for (std::size_t c = 0; c < 3; ++c) {
@@ -464,11 +466,12 @@ void Aggregate::storeInLeafOrder(const std::vector<bvh::BuildItem>& items) {
         indices[3 * t + c] = v;
       }
     }
-    std::vector<Point3> positions(vertices);
-    std::vector<Normal3> normals(mesh.normals.empty() ? 0 : vertices);
-    std::vector<Point2> uvs(mesh.uvs.empty() ? 0 : vertices);
-    std::vector<VertexTangent> tangents(mesh.tangents.empty() ? 0 : vertices);
-    std::vector<Color> colors(mesh.colors.empty() ? 0 : vertices);
+    std::vector<Point3> positions = hugePageVector<Point3>(vertices);
+    std::vector<Normal3> normals = hugePageVector<Normal3>(mesh.normals.empty() ? 0 : vertices);
+    std::vector<Point2> uvs = hugePageVector<Point2>(mesh.uvs.empty() ? 0 : vertices);
+    std::vector<VertexTangent> tangents =
+        hugePageVector<VertexTangent>(mesh.tangents.empty() ? 0 : vertices);
+    std::vector<Color> colors = hugePageVector<Color>(mesh.colors.empty() ? 0 : vertices);
     for (std::size_t old = 0; old < vertexOf.size(); ++old) {
       const std::uint32_t v = vertexOf[old];
       if (v == kUnused) continue;

@@ -187,7 +187,7 @@ class Aggregate {
   // normal: the triangle's unnormalised geometric normal (p1 − p0) × (p2 − p0).
   void finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle, const WatertightHit& candidate,
                          const Vec3& normal, Hit& hit) const;
-  void storeInLeafOrder(const std::vector<bvh::BuildItem>& items);
+  void storeInLeafOrder(const bvh::BuildItems& items);
   friend struct AggregateInspector;  // aggregate_test.cpp checks the node layout invariants
 
   std::vector<Primitive> primitives_;
@@ -199,8 +199,8 @@ class Aggregate {
   // leaf points into leafRefs_ (primitive indices in leaf order); a triangle leaf holds a range of
   // its mesh's triangles, which the build renumbers into leaf order (BruteForce: leafRefs_ holds
   // the triangles of every mesh, see meshBegin_).
-  std::vector<bvh::Node> nodes_;
-  std::vector<bvh::Node8> wideNodes_;
+  bvh::Nodes nodes_;
+  bvh::Nodes8 wideNodes_;
   std::vector<std::uint32_t> leafRefs_;
   // Bvh: per primitive slot of leafRefs_, its sphere record (aggregate_detail::LeafSphere).
   std::vector<aggregate_detail::LeafSphere> leafSpheres_;

@@ -193,8 +193,8 @@ struct AggregateInspector {
 
   // Whether two arrays hold the same bytes (an empty array's data() may be null, which memcmp
   // must not be given even for zero bytes).
-  template <typename T>
-  static bool sameBytes(const std::vector<T>& a, const std::vector<T>& b) {
+  template <typename T, typename Allocator>
+  static bool sameBytes(const std::vector<T, Allocator>& a, const std::vector<T, Allocator>& b) {
     return a.size() == b.size() &&
            (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
   }

@@ -185,7 +185,7 @@ struct Child {
   Decision decision;
 };
 
-bool mixedKeys(const std::vector<BuildItem>& items, const Range& range) {
+bool mixedKeys(const BuildItems& items, const Range& range) {
   const std::uint32_t key = itemKey(items[range.begin]);
   for (std::uint32_t i = range.begin + 1; i < range.end; ++i) {
     if (itemKey(items[i]) != key) return true;
@@ -194,8 +194,7 @@ bool mixedKeys(const std::vector<BuildItem>& items, const Range& range) {
 }
 
 // Fills bins (initialised by the caller; 2 KB, so not returned by value).
-void binRange(const std::vector<BuildItem>& items, const Range& range, const Binning& binning,
-              Bins& bins) {
+void binRange(const BuildItems& items, const Range& range, const Binning& binning, Bins& bins) {
   const BuildItem* data = items.data();
   if (range.count() < kParallelBinThreshold) {
     bins.add(data + range.begin, data + range.end, binning);
@@ -216,8 +215,7 @@ void binRange(const std::vector<BuildItem>& items, const Range& range, const Bin
 }
 
 // forceLeaf: the range is the half of a leaf split to fill a node's slots; it stays a leaf.
-Decision decide(const std::vector<BuildItem>& items, const Range& range, int depth,
-                bool forceLeaf = false) {
+Decision decide(const BuildItems& items, const Range& range, int depth, bool forceLeaf = false) {
   const std::uint32_t count = range.count();
   Decision decision;
   if (count == 1) return decision;
@@ -309,8 +307,7 @@ Decision decide(const std::vector<BuildItem>& items, const Range& range, int dep
 
 // Hoare partition of range by goesLeft, accumulating both sides' bounds as it goes.
 template <class GoesLeft>
-std::pair<Range, Range> partition(std::vector<BuildItem>& items, const Range& range,
-                                  GoesLeft goesLeft) {
+std::pair<Range, Range> partition(BuildItems& items, const Range& range, GoesLeft goesLeft) {
   Range left;
   Range right;
   std::uint32_t i = range.begin;
@@ -330,7 +327,7 @@ std::pair<Range, Range> partition(std::vector<BuildItem>& items, const Range& ra
   return {left, right};
 }
 
-std::pair<Range, Range> split(std::vector<BuildItem>& items, const Child& child) {
+std::pair<Range, Range> split(BuildItems& items, const Child& child) {
   const Range& range = child.range;
   const Decision& d = child.decision;
   switch (d.kind) {
@@ -373,6 +370,10 @@ std::pair<Range, Range> split(std::vector<BuildItem>& items, const Child& child)
   return {left, right};
 }
 
+// Room for the nodes of a subtree over `count` references: about one node per four (leaves of
+// a few references in nodes of four children); more only makes the vector grow once.
+std::size_t nodeCountGuess(std::uint32_t count) { return count / 4 + 1; }
+
 Node emptyNode() {
   Node node{};
   for (int i = 0; i < 4; ++i) {
@@ -386,8 +387,8 @@ Node emptyNode() {
 
 // Appends the subtree of a range that must be split to out (depth-first); returns its root's index
 // in out. Child indices are relative to out's start.
-std::uint32_t buildNode(std::vector<BuildItem>& items, const Range& range, const Decision& decision,
-                        int depth, std::vector<Node>& out) {
+std::uint32_t buildNode(BuildItems& items, const Range& range, const Decision& decision, int depth,
+                        Nodes& out) {
   std::array<Child, 4> children;
   int childCount = 1;
   children[0] = {range, decision};
@@ -456,11 +457,12 @@ std::uint32_t buildNode(std::vector<BuildItem>& items, const Range& range, const
   }
   // The subtrees work on disjoint ranges of items; each is built into its own array and appended in
   // child order, so the layout is the same as the sequential depth-first one.
-  std::array<std::vector<Node>, 4> subtrees;
+  std::array<Nodes, 4> subtrees;
   tbb::task_group group;
   for (int i = 0; i < childCount; ++i) {
     if (children[i].decision.leaf) continue;
     group.run([&, i] {
+      subtrees[i].reserve(nodeCountGuess(children[i].range.count()));
       buildNode(items, children[i].range, children[i].decision, depth + 1, subtrees[i]);
     });
   }
@@ -475,12 +477,12 @@ std::uint32_t buildNode(std::vector<BuildItem>& items, const Range& range, const
       }
       out.push_back(node);
     }
-    std::vector<Node>().swap(subtrees[i]);
+    Nodes().swap(subtrees[i]);
   }
   return nodeIndex;
 }
 
-Range wholeRange(const std::vector<BuildItem>& items) {
+Range wholeRange(const BuildItems& items) {
   const auto count = static_cast<std::uint32_t>(items.size());
   Range range = tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, count, kBinGrain), Range{},
@@ -527,8 +529,7 @@ int childCountOf(const Node& node) {
 }
 
 // Appends the 8-wide node made of 4-wide node `index` and its subtree to out; returns its index.
-std::uint32_t collapseNode(const std::vector<Node>& nodes, std::uint32_t index,
-                           std::vector<Node8>& out) {
+std::uint32_t collapseNode(const Nodes& nodes, std::uint32_t index, Nodes8& out) {
   std::array<SlotRef, Node8::kWidth> slots;
   int count = 0;
   for (int i = 0; i < childCountOf(nodes[index]); ++i) slots[count++] = {index, i};
@@ -597,7 +598,7 @@ BuildItem makeBuildItem(const double lo[3], const double hi[3], std::uint32_t ke
 std::uint32_t itemKey(const BuildItem& item) { return std::bit_cast<std::uint32_t>(item.lo[3]); }
 std::uint32_t itemIndex(const BuildItem& item) { return std::bit_cast<std::uint32_t>(item.hi[3]); }
 
-Tree build(std::vector<BuildItem>& items) {
+Tree build(BuildItems& items) {
   Tree tree;
   if (items.empty()) return tree;
   const Range root = wholeRange(items);
@@ -607,15 +608,15 @@ Tree build(std::vector<BuildItem>& items) {
     tree.rootInfo = leafInfo(itemKey(items[0]), root.count());
     return tree;
   }
-  tree.nodes.reserve(items.size() / 4 + 1);
+  tree.nodes.reserve(nodeCountGuess(root.count()));
   tree.rootChild = buildNode(items, root, decision, 0, tree.nodes);
   tree.rootInfo = kInner;
   tree.nodes.shrink_to_fit();
   return tree;
 }
 
-std::vector<Node8> collapseToWide(const std::vector<Node>& nodes) {
-  std::vector<Node8> wide;
+Nodes8 collapseToWide(const Nodes& nodes) {
+  Nodes8 wide;
   if (nodes.empty()) return wide;
   wide.reserve(nodes.size() / 2 + 1);
   collapseNode(nodes, 0, wide);

@@ -194,7 +194,7 @@ InstanceSet::InstanceSet(std::vector<std::shared_ptr<const Aggregate>> groups,
   // Build items at fixed slots in parallel (one key: every leaf is a range of instances), then
   // the empty ones (instances of empty groups, which nothing can hit) dropped in order.
   const std::size_t n = instances.size();
-  std::vector<bvh::BuildItem> slots(n);
+  bvh::BuildItems slots(n);
   std::vector<std::uint8_t> kind(n);  // 0 dropped, 1 bounded, 2 unbounded
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kInstanceChunk), [&](const auto& range) {
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
@@ -210,7 +210,7 @@ InstanceSet::InstanceSet(std::vector<std::shared_ptr<const Aggregate>> groups,
       kind[i] = 1;
     }
   });
-  std::vector<bvh::BuildItem> items;
+  bvh::BuildItems items;
   items.reserve(n);
   std::vector<PlacedInstance> unboundedInstances;
   for (std::size_t i = 0; i < n; ++i) {
@@ -223,7 +223,7 @@ InstanceSet::InstanceSet(std::vector<std::shared_ptr<const Aggregate>> groups,
       unboundedInstances.push_back(placed(instances[i]));
     }
   }
-  std::vector<bvh::BuildItem>().swap(slots);
+  bvh::BuildItems().swap(slots);
   std::vector<std::uint8_t>().swap(kind);
   if (!items.empty()) {
     bvh::Tree tree = bvh::build(items);

@@ -100,7 +100,7 @@ class InstanceSet {
   std::vector<std::shared_ptr<const Aggregate>> groups_;
   std::vector<PlacedInstance> instances_;  // in leaf order: a leaf is a range of them
   std::vector<std::uint32_t> unbounded_;   // instances of groups with planes or tubes: every ray
-  std::vector<bvh::Node> nodes_;
+  bvh::Nodes nodes_;
   std::uint32_t rootChild_ = 0;
   std::uint32_t rootInfo_ = bvh::kEmpty;
   Bounds3 bounds_;  // of the bounded instances
