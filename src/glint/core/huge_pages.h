@@ -62,7 +62,8 @@ struct HugePageAllocator {
   explicit HugePageAllocator(const HugePageAllocator<U>& /*other*/) noexcept {}
 
   T* allocate(std::size_t n) {
-    if (n > std::numeric_limits<std::size_t>::max() / sizeof(T) - kHugePageBytes) {
+    constexpr auto kMaxBytes = static_cast<std::size_t>(std::numeric_limits<std::ptrdiff_t>::max());
+    if (n > (kMaxBytes - kHugePageBytes) / sizeof(T)) {
       throw std::bad_array_new_length();
     }
     const std::size_t bytes = n * sizeof(T);
