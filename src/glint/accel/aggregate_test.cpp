@@ -18,6 +18,7 @@
 #include <string>
 #include <type_traits>
 #include <variant>
+#include <set>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -1253,6 +1254,35 @@ TEST(AggregateMeshTest, DegenerateTrianglesNeverHit) {
   EXPECT_TRUE(empty.bounds().isEmpty());
   Hit hit;
   EXPECT_FALSE(empty.intersect({{0.5, 0.5, -1}, {0, 0, 1}}, 0, kInfinity, hit));
+}
+
+// Triangle references are made in chunks of 4096 and squeezed past the dropped ones from the
+// first chunk that drops any: a strip of 20000 triangles whose first degenerate one lies in the
+// second chunk keeps every proper triangle exactly once, and leaves holes where the others were.
+TEST(AggregateMeshTest, DegenerateTrianglesInLaterChunksLeaveHolesAndNothingElse) {
+  constexpr std::uint32_t kQuads = 10000;
+  TriangleMesh mesh;
+  for (std::uint32_t i = 0; i <= kQuads; ++i) {
+    mesh.positions.push_back({static_cast<double>(i), 0, 0});
+    mesh.positions.push_back({static_cast<double>(i), 1, 0});
+  }
+  for (std::uint32_t i = 0; i < kQuads; ++i) {
+    const std::uint32_t v = 2 * i;
+    mesh.indices.insert(mesh.indices.end(), {v, v + 2, v + 1, v + 1, v + 2, v + 3});
+  }
+  const std::set<std::uint32_t> holes = {5000, 9001, 12288, 19999};  // triangle numbers
+  for (const std::uint32_t t : holes) mesh.indices[3 * t + 1] = mesh.indices[3 * t];
+  const Aggregate a({}, {}, {mesh}, {Color(0)}, Acceleration::Bvh);
+  EXPECT_EQ(a.triangleCount(), 2 * kQuads - holes.size());
+  AggregateInspector::check(a);
+  Hit hit;
+  for (std::uint32_t t = 0; t < 2 * kQuads; ++t) {
+    // The centroid of triangle t as the strip was made, before the holes.
+    const double x = t / 2 + (t % 2 == 0 ? 1.0 / 3 : 2.0 / 3);
+    const double y = t % 2 == 0 ? 1.0 / 3 : 2.0 / 3;
+    const bool hits = a.intersect({{x, y, 1}, {0, 0, -1}}, 0, kInfinity, hit);
+    EXPECT_EQ(hits, holes.count(t) == 0) << "triangle " << t;
+  }
 }
 
 TEST(AggregateMeshTest, InvalidMeshesAreRejected) {
