@@ -15,10 +15,10 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <set>
 #include <string>
 #include <type_traits>
 #include <variant>
-#include <set>
 #include <vector>
 
 #include <gtest/gtest.h>
