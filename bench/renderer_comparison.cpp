@@ -22,7 +22,8 @@
 //   jittered ones); POV-Ray +AM1 +A0.0 +R2 -J (non-adaptive supersampling of every pixel that
 //   differs from a neighbour, on a 2×2 grid: POV-Ray prints the samples it took, see the logs).
 // - Output: linear values, 8-bit PPM for the timed runs (glint `encoding: linear`, POV-Ray
-//   File_Gamma=1.0, Tachyon writes linear); one PNG per renderer for looking at.
+//   File_Gamma=1.0, Tachyon writes linear); one PNG per renderer for looking at; and timed runs
+//   writing PNG at 1 sample (each renderer's own PNG writer and compression settings).
 // - Floor: an infinite plane in all three. Torus: smooth (interpolated vertex normals) in all
 // three.
 #include <fcntl.h>
@@ -560,6 +561,36 @@ int run(int argc, char** argv) {
         results.push_back({{s.geometry.name, samples, threads}, times});
       }
     }
+  }
+
+  // PNG, every renderer's usual output, costs a serial compression after the parallel render:
+  // the same runs (1 sample, the last thread count) once more, writing PNG.
+  std::printf("\nwriting PNG instead (1 sample per pixel, %d thread(s)):\n", threadCounts.back());
+  for (const ComparisonScene& s : scenes) {
+    std::map<Renderer, Timing> times;
+    for (int run = 0; run < options.runs; ++run) {
+      for (Renderer r : renderers) {
+        const std::string tag = s.geometry.id + "-" + rendererName(r) + "-1spp-" +
+                                std::to_string(threadCounts.back()) + "t";
+        times[r].seconds.push_back(runTimed(renderCommand(r, programs, s.geometry.id, 1,
+                                                          threadCounts.back(), tag + ".png"),
+                                            dir, dir / (tag + "-png-timed.log"))
+                                       .wallSeconds);
+      }
+    }
+    std::printf("%-13s %3d %3d |", s.geometry.name.c_str(), 1, threadCounts.back());
+    for (Renderer r : {Renderer::Glint, Renderer::Tachyon, Renderer::PovRay}) {
+      if (times.count(r)) {
+        std::printf(" %s %7.3f ±%5.1f%% |", rendererName(r), times[r].median(),
+                    times[r].spreadPercent());
+      }
+    }
+    if (times.count(Renderer::Glint) && times.count(Renderer::Tachyon)) {
+      std::printf(" glint/Tachyon %.2f",
+                  times[Renderer::Glint].median() / times[Renderer::Tachyon].median());
+    }
+    std::printf("\n");
+    std::fflush(stdout);
   }
 
   if (threadCounts.size() == 2) {
