@@ -35,6 +35,16 @@ std::filesystem::path findHelperFile(std::string_view name, const char* override
 }  // namespace glint
 
 namespace glint {
+namespace {
+
+// GLINT_MODULE_IDENTITY_FUNCTION's name as a string, for dlsym.
+#define GLINT_QUOTE(name) #name
+#define GLINT_QUOTE_EXPANDED(name) GLINT_QUOTE(name)
+constexpr const char* kIdentityFunctionName = GLINT_QUOTE_EXPANDED(GLINT_MODULE_IDENTITY_FUNCTION);
+#undef GLINT_QUOTE_EXPANDED
+#undef GLINT_QUOTE
+
+}  // namespace
 
 void* loadHelperModule(std::string_view name, const char* override, std::string_view buildPath,
                        std::string_view installPath, const char* identity, const char* entry,
@@ -62,7 +72,7 @@ void* loadHelperModule(std::string_view name, const char* override, std::string_
   }
   using IdentityFunction = const char* (*)();
   const auto moduleIdentity =
-      reinterpret_cast<IdentityFunction>(::dlsym(module, "glint_module_identity"));
+      reinterpret_cast<IdentityFunction>(::dlsym(module, kIdentityFunctionName));
   if (moduleIdentity == nullptr || std::string_view(moduleIdentity()) != identity) {
     error = fmt::format("{} is not the module of this glint ({}; expected '{}')", path.string(),
                         moduleIdentity ? fmt::format("it is '{}'", moduleIdentity())

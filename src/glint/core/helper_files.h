@@ -43,6 +43,14 @@ namespace glint {
 #define GLINT_MODULE_IDENTITY(module, interface) \
   ("glint " GLINT_VERSION " module " module " interface " #interface)
 
+// The function that answers it, exported by every module: GLINT_DEFINE_MODULE_IDENTITY(identity)
+// at namespace scope in the module's source defines it; loadHelperModule looks it up by name.
+#define GLINT_MODULE_IDENTITY_FUNCTION glint_module_identity
+#define GLINT_DEFINE_MODULE_IDENTITY(identity)                                             \
+  extern "C" [[gnu::visibility("default")]] const char* GLINT_MODULE_IDENTITY_FUNCTION() { \
+    return identity;                                                                       \
+  }
+
 // A module (a shared object of this build) loaded on demand: found as findHelperFile says, opened
 // with dlopen (RTLD_NOW: every symbol resolved now, not at a first call in a server thread),
 // checked against `identity`, and `entry` looked up. Returns the entry point, or nullptr with the

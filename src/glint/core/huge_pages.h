@@ -16,14 +16,16 @@
 
 namespace glint {
 
+// The size of a transparent huge page on x86-64.
+inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
+
 // Advises huge pages for the whole 2 MiB pages inside [data, data + bytes), before anything
 // touches them. Below 4 MiB it does nothing.
 inline void adviseHugePages(void* data, std::size_t bytes) {
-  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-  if (bytes < 2 * kHugePage) return;
+  if (bytes < 2 * kHugePageBytes) return;
   const auto begin = reinterpret_cast<std::uintptr_t>(data);
-  const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
-  const std::uintptr_t last = (begin + bytes) & ~(kHugePage - 1);
+  const std::uintptr_t first = (begin + kHugePageBytes - 1) & ~(kHugePageBytes - 1);
+  const std::uintptr_t last = (begin + bytes) & ~(kHugePageBytes - 1);
   if (last > first) {
     static_cast<void>(::madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE));
   }
@@ -55,7 +57,6 @@ std::vector<T> hugePageVector(std::size_t n) {
 template <typename T>
 struct HugePageAllocator {
   using value_type = T;
-  static constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
   HugePageAllocator() = default;
   template <typename U>

@@ -13,7 +13,7 @@
 namespace glint {
 namespace {
 
-constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
+constexpr std::uintptr_t kHugePage = kHugePageBytes;
 
 struct alignas(64) CacheLine {
   unsigned char bytes[64];

@@ -241,16 +241,13 @@ class PpmWriter final : public ImageWriter {
     const std::string header =
         "P6\n" + std::to_string(film.width()) + " " + std::to_string(height) + "\n255\n";
     std::fwrite(header.data(), 1, header.size(), temp.stream());
-    for (int first = 0; first < height; first += kRowsPerBlock) {
+    for (int y = 0; y < height; ++y) {
       throwIfCancelled(control.cancel);
-      const int rows = std::min(kRowsPerBlock, height - first);
-      encodeRows(film, first, rows, encoder, block.data());
-      for (int k = 0; k < rows; ++k) {
-        throwIfCancelled(control.cancel);
-        std::fwrite(block.data() + rowBytes * static_cast<std::size_t>(k), 1, rowBytes,
-                    temp.stream());
-        if (control.rowWritten) control.rowWritten(first + k + 1, height);
-      }
+      if (y % kRowsPerBlock == 0)
+        encodeRows(film, y, std::min(kRowsPerBlock, height - y), encoder, block.data());
+      std::fwrite(block.data() + rowBytes * static_cast<std::size_t>(y % kRowsPerBlock), 1,
+                  rowBytes, temp.stream());
+      if (control.rowWritten) control.rowWritten(y + 1, height);
     }
     temp.commit();
   }

@@ -125,11 +125,9 @@ class OpenExrCodec final : public Codec {
 }  // namespace
 }  // namespace glint::exr_module
 
-extern "C" {
+GLINT_DEFINE_MODULE_IDENTITY(glint::exr_module::kModuleIdentity)
 
-[[gnu::visibility("default")]] const char* glint_module_identity() {
-  return glint::exr_module::kModuleIdentity;
-}
+extern "C" {
 
 [[gnu::visibility("default")]] glint::exr_module::Codec* glint_exr_codec() {
   static glint::exr_module::OpenExrCodec codec;

@@ -117,11 +117,9 @@ class MpiLibrary final : public MpiTransport {
 }  // namespace
 }  // namespace glint::cluster
 
-extern "C" {
+GLINT_DEFINE_MODULE_IDENTITY(glint::cluster::kMpiModuleIdentity)
 
-[[gnu::visibility("default")]] const char* glint_module_identity() {
-  return glint::cluster::kMpiModuleIdentity;
-}
+extern "C" {
 
 [[gnu::visibility("default")]] glint::cluster::MpiTransport* glint_mpi_transport() {
   static glint::cluster::MpiLibrary library;

@@ -128,11 +128,9 @@ void HttpServer::stop() {
 }  // namespace
 }  // namespace glint::preview_http
 
-extern "C" {
+GLINT_DEFINE_MODULE_IDENTITY(glint::preview_http::kModuleIdentity)
 
-[[gnu::visibility("default")]] const char* glint_module_identity() {
-  return glint::preview_http::kModuleIdentity;
-}
+extern "C" {
 
 [[gnu::visibility("default")]] glint::preview_http::Server* glint_preview_http_start(
     const glint::preview_http::Settings& settings) {
