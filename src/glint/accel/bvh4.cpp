@@ -40,6 +40,7 @@ constexpr std::uint32_t kParallelBuildThreshold = 8192;
 constexpr std::uint32_t kParallelBinThreshold = 65536;
 constexpr std::size_t kBinGrain = 16384;
 constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr std::ptrdiff_t kSplitBinsThreshold = 256;
 
 // Lanes 0–2 hold x, y, z; lane 3 is whatever the items carry there (key/index bits) and is never
 // read.
@@ -80,17 +81,22 @@ struct Range {
   std::uint32_t begin = 0;
   std::uint32_t end = 0;
   Box bounds;
-  Box centroids;    // of centroid2
-  double cost = 0;  // Σ costOf over the references
+  Box centroids;                 // of centroid2
+  std::uint32_t primitives = 0;  // references to analytic primitives
 
   std::uint32_t count() const { return end - begin; }
+  // Σ costOf over the references: exact (small integers), and kept as a count of primitives so
+  // that adding a reference is an integer add, not a chain of double-precision adds.
+  double cost() const {
+    return static_cast<double>(count()) + (kPrimitiveCost - 1) * static_cast<double>(primitives);
+  }
   void add(const BuildItem& item) {
     const __m128 lo = _mm_load_ps(item.lo);
     const __m128 hi = _mm_load_ps(item.hi);
     bounds.grow(lo, hi);
     const __m128 c = _mm_add_ps(lo, hi);
     centroids.grow(c, c);
-    cost += costOf(item);
+    primitives += itemKey(item) == kPrimitiveKey ? 1 : 0;
   }
 };
 
@@ -137,20 +143,35 @@ struct Bins {
   void addItems(const BuildItem* begin, const BuildItem* end, const Binning& binning) {
     const __m128 lo = _mm_setr_ps(binning.lo[0], binning.lo[1], binning.lo[2], 0);
     const __m128 scale = _mm_setr_ps(binning.scale[0], binning.scale[1], binning.scale[2], 0);
-    alignas(16) std::array<int, 4> bin;
-    for (const BuildItem* item = begin; item != end; ++item) {
-      const double cost = kWeighted ? costOf(*item) : 1;
-      const __m128 itemLo = _mm_load_ps(item->lo);
-      const __m128 itemHi = _mm_load_ps(item->hi);
-      const __m128 c = _mm_add_ps(itemLo, itemHi);
-      _mm_store_si128(reinterpret_cast<__m128i*>(bin.data()),
-                      _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, lo), scale)));
-      for (int axis = 0; axis < 3; ++axis) {
-        const int b = std::clamp(bin[axis], 0, binCount - 1);
-        bounds[axis][b].grow(itemLo, itemHi);
-        ++counts[axis][b];
-        if constexpr (kWeighted) costs[axis][b] += cost;
+    const BuildItem* item = begin;
+    if (end - begin >= kSplitBinsThreshold) {
+      // Neighbouring items of a mesh mostly fall in the same bins, and each update of a bin's box
+      // waits for the previous one to be stored (a chain of store-to-load forwards). Even and odd
+      // items go to two sets of bins, merged at the end: two independent chains. The merge is
+      // exact (min, max, sums of small integers), so the bins are the same.
+      Bins odd(binCount);
+      for (; end - item >= 2; item += 2) {
+        addItem<kWeighted>(item[0], lo, scale);
+        odd.addItem<kWeighted>(item[1], lo, scale);
       }
+      merge(odd);
+    }
+    for (; item != end; ++item) addItem<kWeighted>(*item, lo, scale);
+  }
+  template <bool kWeighted>
+  void addItem(const BuildItem& item, __m128 lo, __m128 scale) {
+    const double cost = kWeighted ? costOf(item) : 1;
+    const __m128 itemLo = _mm_load_ps(item.lo);
+    const __m128 itemHi = _mm_load_ps(item.hi);
+    const __m128 c = _mm_add_ps(itemLo, itemHi);
+    alignas(16) std::array<int, 4> bin;
+    _mm_store_si128(reinterpret_cast<__m128i*>(bin.data()),
+                    _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, lo), scale)));
+    for (int axis = 0; axis < 3; ++axis) {
+      const int b = std::clamp(bin[axis], 0, binCount - 1);
+      bounds[axis][b].grow(itemLo, itemHi);
+      ++counts[axis][b];
+      if constexpr (kWeighted) costs[axis][b] += cost;
     }
   }
   void merge(const Bins& other) {
@@ -224,7 +245,7 @@ Decision decide(const BuildItems& items, const Range& range, int depth, bool for
   if (depth < kMaxSahDepth) {
     Binning binning;
     binning.binCount = static_cast<int>(std::min<std::uint32_t>(kBinCount, count));
-    binning.weighted = range.cost != static_cast<double>(count);
+    binning.weighted = range.primitives != 0;
     const auto cLo = lanes(range.centroids.lo);
     const auto cHi = lanes(range.centroids.hi);
     bool anyAxis = false;
@@ -286,7 +307,7 @@ Decision decide(const BuildItems& items, const Range& range, int depth, bool for
         const float splitCost = kTraversalCost * area + bestCost;
         // Past the leaf size a split is forced, and the best SAH plane beats a median.
         decision.leaf =
-            !(splitCost < static_cast<float>(range.cost) * area) && count <= kMaxLeafSize;
+            !(splitCost < static_cast<float>(range.cost()) * area) && count <= kMaxLeafSize;
         if (decision.leaf && mixedKeys(items, range)) {
           decision.leaf = false;
           decision.kind = DecisionKind::Key;
@@ -493,7 +514,7 @@ Range wholeRange(const BuildItems& items) {
       [](Range a, const Range& b) {
         a.bounds.grow(b.bounds);
         a.centroids.grow(b.centroids);
-        a.cost += b.cost;
+        a.primitives += b.primitives;
         return a;
       });
   range.begin = 0;
