@@ -3,7 +3,7 @@
 # tetra, tree) at their default sizes with glint and with Tachyon, both on 2 threads, and prints
 # each one's wall time, their ratio and the mean pixel difference between the two images.
 #
-#   bench/spd_bench.sh [SPD_FOLDER] [--images DIR] [--glint PATH] [--keep DIR]
+#   bench/spd_bench.sh [SPD_FOLDER] [--runs N] [--images DIR] [--glint PATH] [--keep DIR]
 #
 # SPD_FOLDER holds NAME.nff.gz (default: ../shared/spd beside the repository; see its README for
 # the generator commands — they are not in this repository, so the files cannot be made here when
@@ -11,7 +11,8 @@
 # renders blank, the others brighter and with another field of view), so Tachyon renders
 # bench/nff_to_tachyon.py's faithful .dat conversion, with -shade_phong (glint's Phong highlight;
 # Tachyon defaults to Blinn's). Times are the whole command (reading, building, rendering,
-# writing), best of one run. The difference is in 8-bit codes per channel (bench/image_diff.py).
+# writing): the median of N runs (default 5), glint's and Tachyon's alternating, with half their
+# range in percent. The difference is in 8-bit codes per channel (bench/image_diff.py).
 # --images DIR writes DIR/spd-NAME.png, glint's image left of Tachyon's. --keep DIR keeps the
 # .nff, .dat and .ppm files. Needs python3 and Tachyon (scripts/setup.sh bench installs it).
 set -euo pipefail
@@ -21,8 +22,10 @@ spd="$ROOT/../shared/spd"
 images=""
 glint="$ROOT/build/glint"
 keep=""
+runs=5
 while (($#)); do
   case "$1" in
+    --runs) runs="${2:?--runs needs a number}"; shift ;;
     --images) images="${2:?--images needs a folder}"; shift ;;
     --glint) glint="${2:?--glint needs a path}"; shift ;;
     --keep) keep="${2:?--keep needs a folder}"; shift ;;
@@ -39,6 +42,7 @@ die() {
 [[ -x "$glint" ]] || die "$glint not found; build glint first (scripts/build.sh)"
 command -v tachyon >/dev/null || die "tachyon not found; install it with scripts/setup.sh bench"
 command -v python3 >/dev/null || die "python3 not found"
+[[ "$runs" =~ ^[1-9][0-9]*$ ]] || die "--runs needs a positive number, not '$runs'"
 scenes=(balls gears mount rings teapot tetra tree)
 for name in "${scenes[@]}"; do
   [[ -f "$spd/$name.nff.gz" ]] ||
@@ -54,26 +58,52 @@ seconds() { # COMMAND...: runs it quietly, prints its wall time in seconds
   local start=$EPOCHREALTIME
   "$@" >/dev/null 2>&1 || die "failed: $*"
   local end=$EPOCHREALTIME
-  python3 -c "print(f'{$end - $start:.2f}')"
+  python3 -c "print(f'{$end - $start:.6f}')"
 }
 
-printf '| scene | glint (s) | Tachyon (s) | Tachyon / glint | mean difference (codes) | pixels > 8 codes off |\n'
+median() { # SECONDS...: prints the median and half the range in percent of it
+  python3 -c "import statistics, sys
+v = [float(x) for x in sys.argv[1:]]
+m = statistics.median(v)
+print(f'{m:.4f} {50 * (max(v) - min(v)) / m:.1f}')" "$@"
+}
+
+printf 'load average at the start: %s\n' "$(cut -d' ' -f1-3 /proc/loadavg)"
+printf 'each time: median of %s runs, glint and Tachyon alternating (+- half the range)\n\n' "$runs"
+printf '| scene | glint (s) | Tachyon (s) | glint / Tachyon | mean difference (codes) | pixels > 8 codes off |\n'
 printf '|---|---:|---:|---:|---:|---:|\n'
+worst_name=""
+worst_ratio=0
 for name in "${scenes[@]}"; do
   gzip -dc "$spd/$name.nff.gz" >"$work/$name.nff"
   python3 "$ROOT/bench/nff_to_tachyon.py" "$work/$name.nff" "$work/$name.dat"
-  glint_s=$(seconds "$glint" render "$work/$name.nff" --threads 2 --quiet -o "$work/$name-glint.ppm")
-  tachyon_s=$(seconds tachyon "$work/$name.dat" -numthreads 2 -shade_phong -format PPM \
-    -o "$work/$name-tachyon.ppm")
+  glint_times=()
+  tachyon_times=()
+  for ((run = 0; run < runs; ++run)); do
+    glint_times+=("$(seconds "$glint" render "$work/$name.nff" --threads 2 --quiet \
+      -o "$work/$name-glint.ppm")")
+    tachyon_times+=("$(seconds tachyon "$work/$name.dat" -numthreads 2 -shade_phong -format PPM \
+      -o "$work/$name-tachyon.ppm")")
+  done
+  read -r glint_s glint_spread < <(median "${glint_times[@]}")
+  read -r tachyon_s tachyon_spread < <(median "${tachyon_times[@]}")
   side=()
   [[ -n "$images" ]] && side=(--side-by-side "$images/spd-$name.png" --width 256)
   read -r mean large < <(python3 "$ROOT/bench/image_diff.py" "$work/$name-glint.ppm" \
     "$work/$name-tachyon.ppm" "${side[@]}")
-  ratio=$(python3 -c "print(f'{$tachyon_s / max($glint_s, 0.01):.2f}')")
+  ratio=$(python3 -c "print(f'{$glint_s / $tachyon_s:.3f}')")
+  if python3 -c "import sys; sys.exit(0 if $ratio > $worst_ratio else 1)"; then
+    worst_ratio=$ratio
+    worst_name=$name
+  fi
   large_pct=$(python3 -c "print(f'{100 * $large:.1f} %')")
-  printf '| %s | %s | %s | %s | %s | %s |\n' "$name" "$glint_s" "$tachyon_s" "$ratio" "$mean" \
-    "$large_pct"
+  printf '| %s | %.3f ± %s %% | %.3f ± %s %% | %s | %s | %s |\n' "$name" "$glint_s" \
+    "$glint_spread" "$tachyon_s" "$tachyon_spread" "$ratio" "$mean" "$large_pct"
 done
+verdict=$(python3 -c "print('MET' if $worst_ratio < 1 else 'NOT MET')")
+printf '\ntarget (issue 16): every SPD scene faster than Tachyon (glint / Tachyon < 1): worst %s %s -> %s\n' \
+  "$worst_name" "$worst_ratio" "$verdict"
+printf 'load average at the end: %s\n' "$(cut -d' ' -f1-3 /proc/loadavg)"
 if [[ -n "$keep" ]]; then
   mkdir -p "$keep"
   cp "$work"/* "$keep"/

@@ -8,8 +8,10 @@
 #   --build-dir DIR  build tree to use (default build/, the release preset's)
 #   --no-build       run what DIR already holds
 #   --only NAMES     comma-separated subset of: ray_throughput, build_memory, bvh_scaling,
-#                    renderer_comparison, adaptive_sampling, path_tracing, instancing
+#                    renderer_comparison, adaptive_sampling, path_tracing, instancing, spd
 #
+# spd is bench/spd_bench.sh (the seven SPD scenes, glint against Tachyon); it needs the SPD files
+# in ../shared/spd beside the repository and is skipped, saying so, without them.
 # Needs Embree 3, Tachyon and POV-Ray (scripts/setup.sh bench installs them). Everything printed is
 # also saved to DIR/bench-results/bench-DATE.txt; the renderer comparison leaves its scenes, logs and
 # one PNG per renderer in DIR/bench-results/renderer_comparison/. The machine should be otherwise idle:
@@ -26,7 +28,7 @@ quick=()
 runs=()
 build_dir=build
 build=1
-only=ray_throughput,build_memory,bvh_scaling,renderer_comparison,adaptive_sampling,path_tracing,instancing
+only=ray_throughput,build_memory,bvh_scaling,renderer_comparison,adaptive_sampling,path_tracing,instancing,spd
 while (($#)); do
   case "$1" in
     --quick) quick=(--quick) ;;
@@ -44,7 +46,7 @@ while (($#)); do
       shift
       ;;
     -h | --help)
-      sed -n '2,19s/^# \{0,1\}//p' "${BASH_SOURCE[0]}"
+      sed -n '2,22s/^# \{0,1\}//p' "${BASH_SOURCE[0]}"
       exit 0
       ;;
     *)
@@ -71,7 +73,7 @@ if ((build)); then
 fi
 
 bench_bin="$build_dir/bench"
-[[ -x "$bench_bin/${only%%,*}" ]] ||
+[[ -x "$bench_bin/ray_throughput" ]] ||
   { printf 'bench: error: no benchmarks in %s (build with -DGLINT_BUILD_BENCH=ON)\n' "$bench_bin" >&2; exit 1; }
 grep -q 'CMAKE_BUILD_TYPE:STRING=Release' "$build_dir/CMakeCache.txt" ||
   printf 'bench: warning: %s is not a Release build; the figures mean little\n' "$build_dir" >&2
@@ -101,6 +103,13 @@ run() {
   run adaptive_sampling "$bench_bin/adaptive_sampling" "${quick[@]}" "${runs[@]}"
   run path_tracing "$bench_bin/path_tracing" "${quick[@]}" "${runs[@]}"
   run instancing "$bench_bin/instancing" "${quick[@]}" "${runs[@]}"
+  if [[ -f "$ROOT/../shared/spd/balls.nff.gz" ]]; then
+    spd_runs=("${runs[@]}")
+    ((${#quick[@]})) && spd_runs=(--runs 1)
+    run spd bash "$ROOT/bench/spd_bench.sh" "${spd_runs[@]}" --glint "$build_dir/glint"
+  elif [[ ",$only," == *",spd,"* ]]; then
+    printf '\nspd: skipped: the SPD files are not in %s\n' "$ROOT/../shared/spd"
+  fi
   printf '\nuptime: %s\n' "$(uptime)"
 } 2>&1 | tee "$log"
 printf 'bench: results saved to %s\n' "$log" >&2
