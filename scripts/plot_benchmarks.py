@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Draws the benchmark figures of docs/benchmarks.md as plots in docs/images/.
 
-    scripts/plot_benchmarks.py [--tables docs/benchmarks.md] [--out docs/images]
+    scripts/plot_benchmarks.py [--tables docs/benchmarks.md] [--out docs/images] [--check]
 
 Reads the result tables in docs/benchmarks.md — the published figures of scripts/bench.sh's runs,
 one table per program, found by their header cells — so each plot always shows the numbers of the
@@ -13,18 +13,26 @@ table beside it: after a new bench run, update the tables, run this, commit both
     adaptive-sampling.png  RMS error against samples per pixel, fixed and adaptive
 
 Needs python3-matplotlib (scripts/setup.sh bench installs it). The PNGs carry no date or version,
-so the same tables give the same files.
+so the same tables give the same files. --check draws nothing and needs no matplotlib: it finds
+each plot's table and checks that its cells read as the plot reads them (the ctest
+benchmark_tables runs it, so that a table added to benchmarks.md cannot hide one of these).
 """
 import argparse
 import os
 import re
 import sys
 
-import matplotlib
-import matplotlib.ticker
+matplotlib = None  # imported by load_matplotlib: --check runs without it
+plt = None
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+
+def load_matplotlib():
+    global matplotlib, plt
+    import matplotlib as mpl
+    import matplotlib.ticker  # noqa: F401
+    mpl.use("Agg")
+    import matplotlib.pyplot as pyplot
+    matplotlib, plt = mpl, pyplot
 
 COLORS = {"glint": "#d9622b", "Embree": "#4a7bb7", "Tachyon": "#5a9e5a", "POV-Ray": "#8e6bb5",
           "brute force": "#999999", "fixed": "#4a7bb7", "adaptive": "#d9622b"}
@@ -164,13 +172,53 @@ def plot_adaptive(all_tables, path):
     save(figure, path)
 
 
+def check_tables(all_tables):
+    """The problems found in the tables the plots read, as messages (none: all readable)."""
+    problems = []
+    header, rows = table_starting(all_tables, "spheres (1 thread, ns per ray")
+    for label in header[1:]:
+        if not re.fullmatch(r"\d+[kM]?", label):
+            problems.append("BVH scaling: column %r is not a sphere count" % label)
+    if not rows:
+        problems.append("BVH scaling: no rows")
+    header, rows = table_starting(all_tables, "ray throughput")
+    for row in rows:
+        for cell in row[1:3]:
+            if len(row) < 3 or None in pair(cell) or len(pair(cell)) != 2:
+                problems.append("ray throughput: %r is not 'N / N' in row %r" % (cell, row[0]))
+    header, rows = table_starting(all_tables, "whole render, seconds")
+    for name in header[1:4]:
+        if name not in COLORS:
+            problems.append("whole renders: column %r is not a renderer (the first table whose "
+                            "first cell starts 'whole render, seconds' is the plotted one)" % name)
+    for row in rows:
+        if any(number(cell) is None for cell in row[1:4] if cell != "-"):
+            problems.append("whole renders: row %r has a cell that is no number" % row[0])
+    header, rows = table_starting(all_tables, "320×180")
+    if not any(row[0].startswith("fixed") for row in rows) or \
+            not any(row[0].startswith("adaptive") for row in rows):
+        problems.append("adaptive sampling: no 'fixed' or no 'adaptive' rows")
+    return problems
+
+
 def main():
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tables", default=os.path.join(root, "docs", "benchmarks.md"))
     parser.add_argument("--out", default=os.path.join(root, "docs", "images"))
+    parser.add_argument("--check", action="store_true",
+                        help="only check that the plotted tables read; draw nothing")
     args = parser.parse_args()
     all_tables = tables(open(args.tables, encoding="utf-8").read())
+    problems = check_tables(all_tables)
+    for problem in problems:
+        print("plot_benchmarks: %s: %s" % (args.tables, problem), file=sys.stderr)
+    if problems:
+        sys.exit(1)
+    if args.check:
+        print("plot_benchmarks: the plotted tables of %s read" % args.tables)
+        return
+    load_matplotlib()
     os.makedirs(args.out, exist_ok=True)
     plt.rcParams.update({"font.size": 9, "svg.hashsalt": "glint"})
     plot_bvh_scaling(all_tables, os.path.join(args.out, "bvh-scaling.png"))
