@@ -1,5 +1,6 @@
 // HugePageAllocator: large blocks are whole, aligned 2 MiB pages advised for huge pages; small
-// ones are ordinary and keep their type's alignment; the arrays behave as vectors.
+// ones are ordinary and keep their type's alignment; the arrays behave as vectors (the unzeroed
+// ones too).
 #include "glint/core/huge_pages.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <numeric>
 #include <sstream>
 #include <string>
+#include <type_traits>
 
 namespace glint {
 namespace {
@@ -68,6 +70,29 @@ TEST(HugePageAllocator, ArraysGrowShrinkAndCopyAsVectors) {
   EXPECT_EQ(grown[599'999], std::uint64_t{599'999} * 599'999);
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(grown.data()) % kHugePage, 0u);
   EXPECT_THROW(grown.get_allocator().allocate(~std::size_t{0} / 4), std::bad_array_new_length);
+}
+
+// The build references' arrays: the same blocks (whole huge pages, advised), and the vector
+// operations that construct from a value still do (only the size constructor and resize without a
+// value leave elements unwritten, for the caller to fill).
+TEST(HugePageAllocator, UnzeroedArraysAreHugePageArraysFilledByTheirUser) {
+  static_assert(
+      std::is_same_v<std::allocator_traits<UnzeroedHugePageAllocator<int>>::rebind_alloc<double>,
+                     UnzeroedHugePageAllocator<double>>);
+  UnzeroedHugePageArray<std::uint32_t> values(3'000'000);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(values.data()) % kHugePage, 0u);
+  EXPECT_NE(vmFlagsOf(values.data()).find(" hg"), std::string::npos);
+  std::iota(values.begin(), values.end(), 0u);
+  EXPECT_EQ(values[2'999'999], 2'999'999u);
+  values.resize(3'000'010, 7u);
+  EXPECT_EQ(values[3'000'000], 7u);
+  EXPECT_EQ(values[3'000'009], 7u);
+  values.push_back(11u);
+  EXPECT_EQ(values.back(), 11u);
+  const UnzeroedHugePageArray<std::uint32_t> copy = values;
+  EXPECT_EQ(copy, values);
+  UnzeroedHugePageArray<std::uint64_t> small(4, 5u);
+  EXPECT_EQ(small, (UnzeroedHugePageArray<std::uint64_t>{5u, 5u, 5u, 5u}));
 }
 
 }  // namespace
