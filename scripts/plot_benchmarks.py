@@ -183,8 +183,11 @@ def check_tables(all_tables):
         problems.append("BVH scaling: no rows")
     header, rows = table_starting(all_tables, "ray throughput")
     for row in rows:
+        if len(row) < 3:
+            problems.append("ray throughput: row %r has no glint and Embree columns" % row[0])
         for cell in row[1:3]:
-            if len(row) < 3 or None in pair(cell) or len(pair(cell)) != 2:
+            values = pair(cell)
+            if len(values) != 2 or None in values:
                 problems.append("ray throughput: %r is not 'N / N' in row %r" % (cell, row[0]))
     header, rows = table_starting(all_tables, "whole render, seconds")
     for name in header[1:4]:
