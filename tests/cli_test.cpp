@@ -250,6 +250,11 @@ const std::vector<BrokenScene> kBrokenScenes{
     {"dat_texfunc_grit.dat",
      "6:11",
      {"TEXFUNC 2 (grit) is not supported by glint", "1 (3D checker)"}},
+    // Found by the fuzzer: a texture function far outside int's range is named, not cast.
+    {"dat_texfunc_huge.dat", "6:11", {"TEXFUNC 4.44444e+82 (unknown) is not supported by glint"}},
+    // Counts larger than the file: an error where the numbers run out, not gigabytes reserved.
+    {"dat_vertex_count_beyond_file.dat", "4:1", {"expected a number (vertex)", "END_SCENE"}},
+    {"dat_triangle_count_beyond_file.dat", "6:1", {"expected a number (vertex index)"}},
 };
 
 TEST_F(Cli, BrokenScenesExitTwoNamingFileLineAndColumn) {

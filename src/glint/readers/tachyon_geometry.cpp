@@ -10,6 +10,11 @@
 
 namespace glint::tachyon {
 
+namespace {
+// Most elements reserved up front for a count read from the file (a million: 80 MB of vertices).
+constexpr std::size_t kReserveLimit = std::size_t{1} << 20;
+}  // namespace
+
 void Geometry::shape(const Token& t, const std::string& word) {
   std::vector<std::pair<std::string_view, Triple>> vectors;
   std::vector<std::pair<std::string_view, Number>> numbers;
@@ -132,10 +137,14 @@ void Geometry::vertexArray(const Token& t) {
     throw SyntaxError{};
   }
   const auto n = static_cast<std::size_t>(count.value);
-  std::vector<VertexData> vertices(n);
+  // The count is the file's claim: the vertices are appended as they are read, so a 40-byte file
+  // claiming 900 million vertices ends at its last number instead of allocating gigabytes first.
+  std::vector<VertexData> vertices;
+  vertices.reserve(std::min<std::size_t>(n, kReserveLimit));
   in_.keyword(t, "COORDS");
-  for (VertexData& v : vertices) {
+  for (std::size_t i = 0; i < n; ++i) {
     const Triple p = in_.point(t, "vertex");
+    VertexData& v = vertices.emplace_back();
     v.ids.position = addTriple(p);
     v.position = p.vector();
   }
@@ -169,7 +178,8 @@ void Geometry::vertexArray(const Token& t) {
         throw SyntaxError{};
       }
       const auto items = static_cast<std::size_t>(m.value) * (strip ? 1 : 3);
-      std::vector<std::size_t> index(items);
+      std::vector<std::size_t> index;  // appended as read, like the vertices above
+      index.reserve(std::min<std::size_t>(items, kReserveLimit));
       for (std::size_t i = 0; i < items; ++i) {
         const Number k = in_.number(t, "vertex index");
         if (!(k.value >= 0 && k.value < static_cast<double>(n) && k.value == std::floor(k.value))) {
@@ -178,7 +188,7 @@ void Geometry::vertexArray(const Token& t) {
                                        block.text, k.text, n, n == 0 ? 0 : n - 1));
           throw SyntaxError{};
         }
-        index[i] = static_cast<std::size_t>(k.value);
+        index.push_back(static_cast<std::size_t>(k.value));
       }
       if (strip) {
         // Tachyon's winding: v0 v1 v2, then v2 v1 v3, v2 v3 v4, …

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <set>
 
 #include <fmt/format.h>
@@ -86,7 +87,11 @@ void Input::emit(std::string_view key, const Triple& t) {
 
 namespace {
 
+// `f` is whatever number the file holds (1e82, -3, 2.5): only the exact integers 1..10 name one of
+// Tachyon's texture functions, and only those are converted to int (a cast of an out-of-range
+// double is undefined behaviour).
 std::string_view texfuncName(double f) {
+  if (!(f >= 1 && f <= 10) || f != std::floor(f)) return "unknown";
   switch (static_cast<int>(f)) {
     case 1:
       return "3D checker";
