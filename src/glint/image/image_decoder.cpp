@@ -2,6 +2,8 @@
 #include "glint/image/image_decoder.h"
 
 #include <jpeglib.h>
+// After jpeglib.h, which it needs.
+#include <jerror.h>
 #include <png.h>
 #include <unistd.h>
 
@@ -155,6 +157,16 @@ void jpegErrorExit(j_common_ptr info) {
   std::longjmp(error->jump, 1);
 }
 void jpegOutputMessage(j_common_ptr) {}
+// libjpeg warns, and goes on, when the data ends before the image does: it fills the missing
+// scanlines with grey. A cut-short file is refused, as PNG and HDR files are; other warnings
+// (stray bytes before a marker, which many cameras write) are passed over as viewers pass them.
+void jpegEmitMessage(j_common_ptr info, int level) {
+  if (level < 0 && info->err->msg_code == JWRN_JPEG_EOF) {
+    auto* error = reinterpret_cast<JpegError*>(info->err);
+    std::snprintf(error->message, sizeof error->message, "the file is cut short");
+    std::longjmp(error->jump, 1);
+  }
+}
 
 bool decodeJpegSamples(std::span<const std::uint8_t> bytes, const ImageHeader& header,
                        std::vector<std::uint8_t>& samples, JpegError& error) {
@@ -162,6 +174,7 @@ bool decodeJpegSamples(std::span<const std::uint8_t> bytes, const ImageHeader& h
   info.err = jpeg_std_error(&error.manager);
   error.manager.error_exit = jpegErrorExit;
   error.manager.output_message = jpegOutputMessage;
+  error.manager.emit_message = jpegEmitMessage;
   if (setjmp(error.jump)) {
     jpeg_destroy_decompress(&info);
     return false;

@@ -135,11 +135,17 @@ TEST(ImageDecoder, JpegFromAssimpTestModels) {
   EXPECT_GE(lo, 0);
   EXPECT_LE(hi, 1);
   EXPECT_GT(hi - lo, 0.2);  // a picture, not a flat colour
-  // Cut in half: libjpeg's error, not a crash (a truncated JPEG may also decode grey; both fine).
-  const std::vector<std::uint8_t> cut(bytes.begin(), bytes.begin() + 200);
-  try {
-    decodeImage(cut, ImageEncoding::Srgb);
-  } catch (const ImageReadError&) {
+  // Cut short anywhere past its header: refused (libjpeg would fill the missing rows with grey and
+  // only warn), never a crash.
+  for (const std::size_t keep : {std::size_t{200}, bytes.size() / 2, bytes.size() - 2}) {
+    SCOPED_TRACE(keep);
+    const std::vector<std::uint8_t> cut(bytes.begin(), bytes.begin() + keep);
+    try {
+      decodeImage(cut, ImageEncoding::Srgb);
+      ADD_FAILURE() << "a JPEG cut to " << keep << " of " << bytes.size() << " bytes decoded";
+    } catch (const ImageReadError& e) {
+      EXPECT_NE(std::string(e.what()).find("invalid JPEG file"), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -83,6 +83,16 @@ void refuseFaces(double faces) {
   }
 }
 
+// Vertices past 2^32 cannot be addressed by a mesh's 32-bit indices (and a count past 2^64 would
+// not even convert to an integer: a header's count is any number it spells).
+void refuseVertices(double vertices) {
+  constexpr double kMaxVertices = 4294967296.0;  // 2^32
+  if (vertices > kMaxVertices) {
+    throw MeshLoadError(fmt::format("its header declares {} vertices, more than the limit of {}",
+                                    formatCount(vertices), formatCount(kMaxVertices)));
+  }
+}
+
 // The first `limit` characters of a line from a file, printable, for a message.
 std::string shown(std::string_view text, std::size_t limit = 40) {
   std::string out;
@@ -143,8 +153,13 @@ PlyElementCounts checkPlyHeader(const std::string& header, std::uint64_t size) {
       if (name == "face") {
         refuseFaces(elementCount);
         faceCount += elementCount;
+        refuseFaces(faceCount);
       }
-      if (name == "vertex") vertexCount += elementCount;
+      if (name == "vertex") {
+        refuseVertices(elementCount);
+        vertexCount += elementCount;
+        refuseVertices(vertexCount);
+      }
       declared +=
           fmt::format("{}{} {}", declared.empty() ? "" : " and ", formatCount(elementCount), name);
     } else if (keyword == "property") {

@@ -66,6 +66,15 @@ TEST(MeshFormatChecks, HeaderCountsTheFileCannotHoldAreRefusedBeforeReading) {
               HasSubstr("more than its"));
   EXPECT_THAT(reasonFor(dir.write("c.ply", ply("ascii", "3", "300000000"))),
               HasSubstr("declares 300.0 million faces, more than the limit of 268.4 million"));
+  // A vertex element without properties weighs nothing, so only the count limit refuses it (a
+  // count past 2^64 must not reach an integer conversion), and face elements count together.
+  EXPECT_THAT(
+      reasonFor(dir.write("e.ply", "ply\nformat ascii 1.0\nelement vertex 1e30\nend_header\n")),
+      HasSubstr("declares 1.0e+30 vertices, more than the limit of 4.3 billion"));
+  EXPECT_THAT(reasonFor(dir.write("f.ply",
+                                  "ply\nformat ascii 1.0\nelement face 200000000\nelement face "
+                                  "200000000\nend_header\n")),
+              HasSubstr("faces, more than the limit of 268.4 million"));
   // The same header with counts the file does hold loads.
   const MeshFile small = readMeshFile(dir.write("d.ply", ply("ascii", "3", "1")));
   EXPECT_EQ(small.triangleCount(), 1u);

@@ -216,8 +216,13 @@ std::chrono::steady_clock::duration meshReadTimeLimit(const std::filesystem::pat
   std::error_code error;
   const std::uintmax_t size = std::filesystem::file_size(path, error);
   const double mib = error ? 0 : static_cast<double>(size) / (1024.0 * 1024.0);
+  // At most a day: the limit is added to steady_clock::now(), whose nanosecond count a (sparse)
+  // file of petabytes would otherwise carry past 2^63.
+  constexpr double kMostSeconds = 24 * 3600;
+  const double seconds =
+      std::min(kMeshReadBaseSeconds + kMeshReadSecondsPerMiB * mib, kMostSeconds);
   return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-      std::chrono::duration<double>(kMeshReadBaseSeconds + kMeshReadSecondsPerMiB * mib));
+      std::chrono::duration<double>(seconds));
 }
 
 }  // namespace

@@ -15,8 +15,8 @@
 namespace glint {
 
 // A mesh file is read by assimp in a child process, which may take kMeshReadBaseSeconds plus
-// kMeshReadSecondsPerMiB per MiB of the file; past that it is stopped and the file refused (an
-// importer that loops on a malformed file must not hang glint).
+// kMeshReadSecondsPerMiB per MiB of the file (at most a day); past that it is stopped and the file
+// refused (an importer that loops on a malformed file must not hang glint).
 inline constexpr double kMeshReadBaseSeconds = 30;
 inline constexpr double kMeshReadSecondsPerMiB = 2;
 

@@ -143,13 +143,25 @@ Color evaluateImage(const ImageTexture& t, const TextureLookup& at) {
 
 }  // namespace
 
+namespace {
+
+// The lattice cell of an integral coordinate, modulo 256. Past 2^62 (an octave's frequency takes a
+// tamed 1e15 there) the exact fmod brings it into int64's range first, so the cast is defined and
+// gives the same low eight bits; a non-finite coordinate takes cell 0.
+int latticeCell(double cell) {
+  if (!(std::abs(cell) < 0x1p62)) cell = std::isfinite(cell) ? std::fmod(cell, 256.0) : 0;
+  return static_cast<int>(static_cast<std::int64_t>(cell) & 255);
+}
+
+}  // namespace
+
 double perlinNoise(const Point3& p) {
   const double fx = std::floor(p.x);
   const double fy = std::floor(p.y);
   const double fz = std::floor(p.z);
-  const int X = static_cast<int>(static_cast<std::int64_t>(fx) & 255);
-  const int Y = static_cast<int>(static_cast<std::int64_t>(fy) & 255);
-  const int Z = static_cast<int>(static_cast<std::int64_t>(fz) & 255);
+  const int X = latticeCell(fx);
+  const int Y = latticeCell(fy);
+  const int Z = latticeCell(fz);
   const double x = p.x - fx;
   const double y = p.y - fy;
   const double z = p.z - fz;

@@ -125,6 +125,14 @@ TEST(Texture, PerlinNoiseIsZeroOnTheLatticeAndBounded) {
     const double n = perlinNoise({i * 0.173, i * 0.311, i * 0.0917});
     EXPECT_LE(std::abs(n), 1.0);
   }
+  // Lattice points past int64's range (a tamed 1e15 times an octave's 2^15): on the lattice, so 0
+  // (the sanitizers' float-cast-overflow check sees the cell's conversion).
+  EXPECT_EQ(perlinNoise({1.6384e19, 3.3e19, -3.3e19}), 0);
+  const Texture fine =
+      NoiseTexture{NoisePattern::Noise, {Color(0.2), Color(0.6)}, 1e-16, 0, 16, Point3{}};
+  const double far = evaluate(fine, {{0.3, 0.7, 0.1}, {}, {}, {}}).r;
+  EXPECT_GE(far, 0.2 - kTol);
+  EXPECT_LE(far, 0.6 + kTol);
   // The marble, wood and noise patterns stay between their two colours.
   for (const NoisePattern pattern :
        {NoisePattern::Noise, NoisePattern::Marble, NoisePattern::Wood}) {
