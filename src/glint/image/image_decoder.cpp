@@ -331,9 +331,52 @@ ReadableFile openImageFile(const std::filesystem::path& path) {
 
 }  // namespace
 
+// The fewest bytes a file of `header` can have, by the best each format's coding can do, or 0
+// when no useful bound is known: a file below it is cut short, and is refused before its pixels
+// (up to 3 GB of them) are allocated. PNG: the rows' bytes (a filter byte, then the samples at
+// the IHDR's bit depth and colour type) deflated at deflate's best ratio, 1032:1 (a 258-byte
+// match in two bits). HDR: a scanline is at least its 4-byte header and, per plane, a 2-byte run
+// per 127 pixels, or flat RGBE pixels where runs are not allowed. JPEG (arithmetic coding can
+// take less than a bit a block) and EXR are not bounded here.
+std::uint64_t fewestFileBytes(std::span<const std::uint8_t> bytes, const ImageHeader& header,
+                              std::size_t pixelsStart) {
+  const std::uint64_t width = header.width;
+  const std::uint64_t height = header.height;
+  switch (header.format) {
+    case ImageFormat::Png: {
+      // IHDR's data starts at 16 (signature, length, type): width, height, depth, colour type.
+      if (bytes.size() < 26) return 0;
+      const std::uint64_t depth = bytes[24];
+      const std::uint8_t colourType = bytes[25];
+      const std::uint64_t channels = colourType == 2   ? 3
+                                     : colourType == 4 ? 2
+                                     : colourType == 6 ? 4
+                                                       : 1;
+      const std::uint64_t rowBytes = 1 + (width * channels * depth + 7) / 8;
+      return height * rowBytes / 1032;
+    }
+    case ImageFormat::Hdr: {
+      const bool runsAllowed = width >= 8 && width < 32768;
+      const std::uint64_t scanline = runsAllowed ? 4 + 4 * 2 * ((width + 126) / 127) : 4 * width;
+      return pixelsStart + height * scanline;
+    }
+    case ImageFormat::Jpeg:
+    case ImageFormat::Exr:
+      break;
+  }
+  return 0;
+}
+
 RgbImage decodeImage(std::span<const std::uint8_t> bytes, ImageEncoding encoding) {
   std::size_t pixelsStart = 0;
   const ImageHeader header = readImageHeader(bytes, &pixelsStart);
+  if (const std::uint64_t fewest = fewestFileBytes(bytes, header, pixelsStart);
+      bytes.size() < fewest) {
+    throw ImageReadError(fmt::format(
+        "invalid {} file: it is cut short ({} bytes, where a {}×{} image needs at least {})",
+        header.format == ImageFormat::Png ? "PNG" : "HDR", bytes.size(), header.width,
+        header.height, fewest));
+  }
   switch (header.format) {
     case ImageFormat::Png:
       return decodePng(bytes, header, encoding);

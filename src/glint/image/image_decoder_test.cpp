@@ -117,6 +117,39 @@ TEST(ImageDecoder, RadianceHdrFlatAndRunLength) {
   }
 }
 
+TEST(ImageDecoder, FilesTooShortForTheirSizeAreRefusedBeforeTheirPixelsAreAllocated) {
+  // A scanline of 127 pixels in one run per plane is the shortest an HDR scanline can be: read.
+  const std::string shortest = hdrFile(127, true);
+  EXPECT_EQ(
+      decodeImage(std::vector<std::uint8_t>(shortest.begin(), shortest.end()), ImageEncoding::Srgb)
+          .pixels.size(),
+      127u * 3);
+  // A few bytes claiming 8192 × 8192 pixels (805 MB of floats): refused by their count.
+  const auto expectCutShort = [](const std::vector<std::uint8_t>& bytes, const char* what) {
+    try {
+      decodeImage(bytes, ImageEncoding::Srgb);
+      ADD_FAILURE() << what << " was decoded";
+    } catch (const ImageReadError& e) {
+      EXPECT_NE(std::string(e.what()).find("it is cut short"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("8192×8192 image needs at least"), std::string::npos)
+          << e.what();
+    }
+  };
+  std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 8192\n";
+  hdr += std::string(40, '\x02');
+  expectCutShort(std::vector<std::uint8_t>(hdr.begin(), hdr.end()), "a 51-byte HDR");
+  const fs::path png = scratch("claims.png");
+  writeImage(codesFilm(), png, Encoding::Srgb);
+  std::vector<std::uint8_t> bytes = bytesOf(png);
+  for (const int at : {16, 20}) {  // IHDR's width and height, big-endian
+    bytes[at] = 0;
+    bytes[at + 1] = 0;
+    bytes[at + 2] = 0x20;
+    bytes[at + 3] = 0;
+  }
+  expectCutShort(bytes, "a small PNG claiming 8192 × 8192");
+}
+
 TEST(ImageDecoder, JpegFromAssimpTestModels) {
   const fs::path jpeg = "/usr/share/assimp/models/OBJ/wal67ar_small.jpg";
   if (!fs::exists(jpeg)) GTEST_SKIP() << "assimp-testmodels is not installed";
