@@ -15,6 +15,8 @@
 #include <limits>
 #include <utility>
 
+#include "glint/core/ulp.h"
+
 namespace glint::bvh {
 
 namespace {
@@ -235,6 +237,74 @@ void binRange(const BuildItems& items, const Range& range, const Binning& binnin
       });
 }
 
+// The SAH sweep over the bins of every binned axis: lowers bestCost to the least cost of a plane
+// (halfArea · cost on each side) and sets decision's axis and bin to it; ties keep the first
+// (lowest axis, then lowest bin).
+void bestPlane(const Bins& bins, const Binning& binning, float& bestCost, Decision& decision) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (binning.scale[axis] == 0) continue;
+    // Sweep from the right for the high side of every plane, then from the left; the plane
+    // after bin b puts bins [0, b] on the low side.
+    std::array<float, kBinCount> rightArea{};
+    std::array<std::uint32_t, kBinCount> rightCount{};
+    std::array<double, kBinCount> rightCost{};
+    Box right;
+    std::uint32_t highCount = 0;
+    double highCost = 0;
+    const int binCount = binning.binCount;
+    for (int b = binCount - 1; b > 0; --b) {
+      right.grow(bins.bounds[axis][b]);
+      highCount += bins.counts[axis][b];
+      highCost += binning.weighted ? bins.costs[axis][b] : bins.counts[axis][b];
+      rightArea[b - 1] = halfArea(right);
+      rightCount[b - 1] = highCount;
+      rightCost[b - 1] = highCost;
+    }
+    Box left;
+    std::uint32_t lowCount = 0;
+    double lowCost = 0;
+    for (int b = 0; b < binCount - 1; ++b) {
+      left.grow(bins.bounds[axis][b]);
+      lowCount += bins.counts[axis][b];
+      lowCost += binning.weighted ? bins.costs[axis][b] : bins.counts[axis][b];
+      if (lowCount == 0 || rightCount[b] == 0) continue;
+      const float cost = halfArea(left) * static_cast<float>(lowCost) +
+                         rightArea[b] * static_cast<float>(rightCost[b]);
+      if (cost < bestCost) {
+        bestCost = cost;
+        decision.axis = axis;
+        decision.bin = b;
+      }
+    }
+  }
+}
+
+// bestPlane for a range of two references of cost 1 (a quarter of the ranges a mesh's build
+// decides), without binning them: on every binned axis their centroids are the ends of the
+// centroid extent, so they fall in the two bins, one each, and the one plane costs
+// halfArea(first) · 1 + halfArea(second) · 1 in either order (float addition commutes) — the
+// same on every axis, so the sweep would keep the first binned axis. Same operations, same result.
+void bestPlaneOfTwo(const BuildItem& first, const BuildItem& second, const Binning& binning,
+                    float& bestCost, Decision& decision) {
+  // The sweep's axes: those binned with a non-zero scale (an infinite extent binned at scale 0
+  // has every reference in one bin, and no plane).
+  const int axis = binning.scale[0] != 0   ? 0
+                   : binning.scale[1] != 0 ? 1
+                   : binning.scale[2] != 0 ? 2
+                                           : -1;
+  if (axis < 0) return;
+  Box a;
+  a.grow(_mm_load_ps(first.lo), _mm_load_ps(first.hi));
+  Box b;
+  b.grow(_mm_load_ps(second.lo), _mm_load_ps(second.hi));
+  const float cost = halfArea(a) * 1.0f + halfArea(b) * 1.0f;
+  if (cost < bestCost) {
+    bestCost = cost;
+    decision.axis = axis;
+    decision.bin = 0;
+  }
+}
+
 // forceLeaf: the range is the half of a leaf split to fill a node's slots; it stays a leaf.
 Decision decide(const BuildItems& items, const Range& range, int depth, bool forceLeaf = false) {
   const std::uint32_t count = range.count();
@@ -259,44 +329,13 @@ Decision decide(const BuildItems& items, const Range& range, int depth, bool for
       }
     }
     if (anyAxis) {
-      Bins bins(binning.binCount);
-      binRange(items, range, binning, bins);
       float bestCost = kInf;
-      for (int axis = 0; axis < 3; ++axis) {
-        if (binning.scale[axis] == 0) continue;
-        // Sweep from the right for the high side of every plane, then from the left; the plane
-        // after bin b puts bins [0, b] on the low side.
-        std::array<float, kBinCount> rightArea{};
-        std::array<std::uint32_t, kBinCount> rightCount{};
-        std::array<double, kBinCount> rightCost{};
-        Box right;
-        std::uint32_t highCount = 0;
-        double highCost = 0;
-        const int binCount = binning.binCount;
-        for (int b = binCount - 1; b > 0; --b) {
-          right.grow(bins.bounds[axis][b]);
-          highCount += bins.counts[axis][b];
-          highCost += binning.weighted ? bins.costs[axis][b] : bins.counts[axis][b];
-          rightArea[b - 1] = halfArea(right);
-          rightCount[b - 1] = highCount;
-          rightCost[b - 1] = highCost;
-        }
-        Box left;
-        std::uint32_t lowCount = 0;
-        double lowCost = 0;
-        for (int b = 0; b < binCount - 1; ++b) {
-          left.grow(bins.bounds[axis][b]);
-          lowCount += bins.counts[axis][b];
-          lowCost += binning.weighted ? bins.costs[axis][b] : bins.counts[axis][b];
-          if (lowCount == 0 || rightCount[b] == 0) continue;
-          const float cost = halfArea(left) * static_cast<float>(lowCost) +
-                             rightArea[b] * static_cast<float>(rightCost[b]);
-          if (cost < bestCost) {
-            bestCost = cost;
-            decision.axis = axis;
-            decision.bin = b;
-          }
-        }
+      if (count == 2 && !binning.weighted) {
+        bestPlaneOfTwo(items[range.begin], items[range.begin + 1], binning, bestCost, decision);
+      } else {
+        Bins bins(binning.binCount);
+        binRange(items, range, binning, bins);
+        bestPlane(bins, binning, bestCost, decision);
       }
       if (bestCost < kInf) {
         decision.kind = DecisionKind::Sah;
@@ -522,11 +561,16 @@ Range wholeRange(const BuildItems& items) {
   return range;
 }
 
+// One float ulp outward from the nearest float: std::nextafter toward ∓inf, inline (a libm call
+// per coordinate was 2 % of a 100k-triangle build). ±inf and NaN are kept as nextafter keeps them
+// (nextUp's bit step assumes a finite value).
 float roundDown(double x) {
-  return std::nextafter(static_cast<float>(x), -std::numeric_limits<float>::infinity());
+  const auto f = static_cast<float>(x);
+  return f > -kInf ? nextDown(f) : f;
 }
 float roundUp(double x) {
-  return std::nextafter(static_cast<float>(x), std::numeric_limits<float>::infinity());
+  const auto f = static_cast<float>(x);
+  return f < kInf ? nextUp(f) : f;
 }
 
 // One child slot of a node during the collapse: the 4-wide node it lives in and its slot there.
