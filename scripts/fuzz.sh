@@ -6,7 +6,7 @@
 #
 # SECONDS per fuzz target, default 60; --total SECONDS shares that time among the targets (CI).
 # --only NAME runs that target only (scene_loader, nff, tachyon, mesh_obj, mesh_ply, mesh_stl,
-# mesh_gltf, image_header, image_decode, mesh_texture, obj_fast_parse).
+# mesh_gltf, image_header, image_decode, mesh_texture, obj_fast_parse, checkpoint).
 # Longer runs: `scripts/fuzz.sh 3600`; on both cores: `scripts/fuzz.sh 3600 -- -fork=2`.
 # The working corpus BUILD/corpus/NAME/ persists between runs (it grows), seeded from
 # fuzz/corpus/NAME/ and scenes/ (scene_loader: *.yaml, nff: *.nff, tachyon: *.dat). A finding
