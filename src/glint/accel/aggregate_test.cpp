@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -24,7 +23,6 @@
 
 #include <gtest/gtest.h>
 
-#include "glint/accel/bvh4.h"
 #include "glint/core/rng.h"
 
 namespace glint {
@@ -1636,42 +1634,6 @@ TEST(AggregateIsaTest, AggregatesStartWithTheProcessDefault) {
     EXPECT_EQ(isaName(aggregate.isa()), forced);
   } else {
     EXPECT_EQ(aggregate.isa(), bestIsa(isaSupportHere()));
-  }
-}
-
-// A build reference's box is its double box rounded outward by at least one float ulp, exactly as
-// std::nextafter toward ∓inf does it (the build's inline ulp step must agree on zeros, subnormals,
-// the largest float, overflow to infinity and NaN).
-TEST(BuildItemTest, BoxIsRoundedOutwardLikeNextafter) {
-  constexpr double kInfD = std::numeric_limits<double>::infinity();
-  constexpr float kInfF = std::numeric_limits<float>::infinity();
-  // Each value and its negation: zeros, subnormals, ordinary values, the largest float, values
-  // that overflow float, infinity; then NaN and random magnitudes from 1e-30 to 1e29.
-  std::vector<double> values = {std::numeric_limits<double>::quiet_NaN()};
-  for (const double v : {0.0, 1e-46, 1e-40, 1.0, 0.1, 3.4028234663852886e38, 1e39, 1e300, kInfD}) {
-    values.push_back(v);
-    values.push_back(-v);
-  }
-  Rng rng(7);
-  for (int i = 0; i < 1000; ++i)
-    values.push_back((rng.uniform() - 0.5) * std::pow(10.0, i % 60 - 30));
-  const auto same = [](float a, float b) {
-    return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b) ||
-           (std::isnan(a) && std::isnan(b));
-  };
-  for (const double v : values) {
-    SCOPED_TRACE(v);
-    const double lo[3] = {v, v, v};
-    const double hi[3] = {v, v, v};
-    const bvh::BuildItem item = bvh::makeBuildItem(lo, hi, 3, 5);
-    const float down = std::nextafter(static_cast<float>(v), -kInfF);
-    const float up = std::nextafter(static_cast<float>(v), kInfF);
-    for (int axis = 0; axis < 3; ++axis) {
-      EXPECT_TRUE(same(item.lo[axis], down)) << item.lo[axis] << " vs " << down;
-      EXPECT_TRUE(same(item.hi[axis], up)) << item.hi[axis] << " vs " << up;
-    }
-    EXPECT_EQ(bvh::itemKey(item), 3u);
-    EXPECT_EQ(bvh::itemIndex(item), 5u);
   }
 }
 

@@ -103,10 +103,13 @@ struct Range {
 };
 
 // Bin of a doubled centroid coordinate; the same float arithmetic as the SSE binning loop, so the
-// partition agrees with the bin counts exactly.
+// partition agrees with the bin counts exactly. A NaN (the centroid of a box spanning −inf..+inf)
+// goes to bin 0, where the loop's truncation (INT_MIN for NaN) and clamp put it, without the
+// undefined cast of NaN to int.
 int binIndex(float c, float lo, float scale, int binCount) {
-  const auto b = static_cast<int>((c - lo) * scale);
-  return std::clamp(b, 0, binCount - 1);
+  const float offset = (c - lo) * scale;
+  if (!(offset >= 0)) return 0;
+  return std::min(static_cast<int>(offset), binCount - 1);
 }
 
 struct Binning {
@@ -562,8 +565,8 @@ Range wholeRange(const BuildItems& items) {
 }
 
 // One float ulp outward from the nearest float: std::nextafter toward ∓inf, inline (a libm call
-// per coordinate was 2 % of a 100k-triangle build). ±inf and NaN are kept as nextafter keeps them
-// (nextUp's bit step assumes a finite value).
+// per coordinate was 2 % of a 100k-triangle build). NaN and the infinity stepped toward are
+// returned unchanged, as nextafter returns them; the other infinity steps to ∓FLT_MAX, as it does.
 float roundDown(double x) {
   const auto f = static_cast<float>(x);
   return f > -kInf ? nextDown(f) : f;

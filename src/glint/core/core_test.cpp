@@ -497,6 +497,10 @@ void expectStepsAsNextafter() {
     EXPECT_EQ(std::bit_cast<Bits>(nextUp(x)), std::bit_cast<Bits>(std::nextafter(x, kInf))) << x;
     EXPECT_EQ(std::bit_cast<Bits>(nextDown(x)), std::bit_cast<Bits>(std::nextafter(x, -kInf))) << x;
   }
+  // Each infinity steps away from itself to the largest finite value (the build's outward rounding
+  // relies on it).
+  EXPECT_EQ(std::bit_cast<Bits>(nextUp(-kInf)), std::bit_cast<Bits>(std::nextafter(-kInf, kInf)));
+  EXPECT_EQ(std::bit_cast<Bits>(nextDown(kInf)), std::bit_cast<Bits>(std::nextafter(kInf, -kInf)));
 }
 
 TEST(CoreUlp, NextUpAndDownStepExactlyAsNextafter) {

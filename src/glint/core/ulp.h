@@ -9,9 +9,10 @@
 
 namespace glint {
 
-// The next representable value above x (toward +inf): std::nextafter(x, +inf) for finite x, without
-// the library call (it runs per traversal and per spawned ray). −0 and +0 both step to the smallest
-// subnormal; the largest finite value steps to +inf.
+// The next representable value above x (toward +inf): std::nextafter(x, +inf) for x finite or
+// −inf (which steps to the lowest finite value), without the library call (it runs per traversal
+// and per spawned ray). −0 and +0 both step to the smallest subnormal; the largest finite value
+// steps to +inf. Not for +inf or NaN (the bit step would make a NaN, or another NaN).
 template <std::floating_point T>
 T nextUp(T x) {
   using Bits = std::conditional_t<sizeof(T) == 4, std::uint32_t, std::uint64_t>;

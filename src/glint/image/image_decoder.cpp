@@ -158,18 +158,33 @@ void jpegErrorExit(j_common_ptr info) {
 }
 void jpegOutputMessage(j_common_ptr) {}
 // libjpeg warns, and goes on, when the data ends before the image does: it fills the missing
-// scanlines with grey. A cut-short file is refused, as PNG and HDR files are; other warnings
-// (stray bytes before a marker, which many cameras write) are passed over as viewers pass them.
+// scanlines with grey. A cut-short file is refused, as PNG and HDR files are: the file's end
+// (JWRN_JPEG_EOF) or its end marker (JWRN_HIT_MARKER: decodeJpegSamples appends one to a file
+// without it) met inside the entropy-coded data. Other warnings (stray bytes before a marker,
+// which many cameras write) are passed over as viewers pass them.
 void jpegEmitMessage(j_common_ptr info, int level) {
-  if (level < 0 && info->err->msg_code == JWRN_JPEG_EOF) {
+  if (level < 0 &&
+      (info->err->msg_code == JWRN_JPEG_EOF || info->err->msg_code == JWRN_HIT_MARKER)) {
     auto* error = reinterpret_cast<JpegError*>(info->err);
     std::snprintf(error->message, sizeof error->message, "the file is cut short");
     std::longjmp(error->jump, 1);
   }
 }
 
-bool decodeJpegSamples(std::span<const std::uint8_t> bytes, const ImageHeader& header,
+bool decodeJpegSamples(std::span<const std::uint8_t> file, const ImageHeader& header,
                        std::vector<std::uint8_t>& samples, JpegError& error) {
+  // A file whose data is whole but lacks the end marker (FF D9) decodes as if it had one: the
+  // marker is appended, so that only missing data is "cut short". (Before the setjmp below: a
+  // longjmp must not cross a live object's lifetime.)
+  std::vector<std::uint8_t> ended;
+  std::span<const std::uint8_t> bytes = file;
+  if (file.size() < 2 || file[file.size() - 2] != 0xFF || file[file.size() - 1] != 0xD9) {
+    ended.reserve(file.size() + 2);
+    ended.assign(file.begin(), file.end());
+    ended.push_back(0xFF);
+    ended.push_back(0xD9);
+    bytes = ended;
+  }
   jpeg_decompress_struct info;
   info.err = jpeg_std_error(&error.manager);
   error.manager.error_exit = jpegErrorExit;
@@ -243,6 +258,10 @@ void rgbeToFloat(const std::uint8_t* rgbe, float* out) {
   for (int c = 0; c < 3; ++c) out[c] = (static_cast<float>(rgbe[c]) + 0.5f) * scale;
 }
 
+// Whether an HDR scanline of this width may be run-length encoded (the new scheme: the reader and
+// the file-size bound share this rule).
+bool hdrRunsAllowed(std::uint32_t width) { return width >= 8 && width < 32768; }
+
 RgbImage decodeHdr(std::span<const std::uint8_t> bytes, const ImageHeader& header,
                    std::size_t pixelsStart) {
   const std::uint32_t width = header.width;
@@ -254,7 +273,7 @@ RgbImage decodeHdr(std::span<const std::uint8_t> bytes, const ImageHeader& heade
   };
   for (std::uint32_t y = 0; y < header.height; ++y) {
     need(4);
-    const bool runLength = width >= 8 && width < 32768 && bytes[at] == 2 && bytes[at + 1] == 2 &&
+    const bool runLength = hdrRunsAllowed(width) && bytes[at] == 2 && bytes[at + 1] == 2 &&
                            (bytes[at + 2] & 0x80) == 0;
     if (runLength) {
       if ((std::uint32_t{bytes[at + 2]} << 8 | bytes[at + 3]) != width) {
@@ -329,8 +348,6 @@ ReadableFile openImageFile(const std::filesystem::path& path) {
   throw ImageReadError("cannot open it: " + systemReason(file.error));
 }
 
-}  // namespace
-
 // The fewest bytes a file of `header` can have, by the best each format's coding can do, or 0
 // when no useful bound is known: a file below it is cut short, and is refused before its pixels
 // (up to 3 GB of them) are allocated. PNG: the rows' bytes (a filter byte, then the samples at
@@ -356,8 +373,8 @@ std::uint64_t fewestFileBytes(std::span<const std::uint8_t> bytes, const ImageHe
       return height * rowBytes / 1032;
     }
     case ImageFormat::Hdr: {
-      const bool runsAllowed = width >= 8 && width < 32768;
-      const std::uint64_t scanline = runsAllowed ? 4 + 4 * 2 * ((width + 126) / 127) : 4 * width;
+      const std::uint64_t scanline =
+          hdrRunsAllowed(header.width) ? 4 + 4 * 2 * ((width + 126) / 127) : 4 * width;
       return pixelsStart + height * scanline;
     }
     case ImageFormat::Jpeg:
@@ -367,15 +384,17 @@ std::uint64_t fewestFileBytes(std::span<const std::uint8_t> bytes, const ImageHe
   return 0;
 }
 
+}  // namespace
+
 RgbImage decodeImage(std::span<const std::uint8_t> bytes, ImageEncoding encoding) {
   std::size_t pixelsStart = 0;
   const ImageHeader header = readImageHeader(bytes, &pixelsStart);
   if (const std::uint64_t fewest = fewestFileBytes(bytes, header, pixelsStart);
       bytes.size() < fewest) {
-    throw ImageReadError(fmt::format(
-        "invalid {} file: it is cut short ({} bytes, where a {}×{} image needs at least {})",
-        header.format == ImageFormat::Png ? "PNG" : "HDR", bytes.size(), header.width,
-        header.height, fewest));
+    throw ImageReadError(
+        fmt::format("invalid {} file: it is cut short ({} bytes; {}×{} pixels need at least {})",
+                    header.format == ImageFormat::Png ? "PNG" : "HDR", bytes.size(), header.width,
+                    header.height, fewest));
   }
   switch (header.format) {
     case ImageFormat::Png:

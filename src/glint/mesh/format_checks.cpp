@@ -150,13 +150,12 @@ PlyElementCounts checkPlyHeader(const std::string& header, std::uint64_t size) {
         throw MeshLoadError(
             fmt::format("its PLY header has an element without a valid count: '{}'", shown(line)));
       }
+      // Checked as the elements add up (several face elements count together).
       if (name == "face") {
-        refuseFaces(elementCount);
         faceCount += elementCount;
         refuseFaces(faceCount);
       }
       if (name == "vertex") {
-        refuseVertices(elementCount);
         vertexCount += elementCount;
         refuseVertices(vertexCount);
       }

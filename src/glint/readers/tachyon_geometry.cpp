@@ -11,7 +11,7 @@
 namespace glint::tachyon {
 
 namespace {
-// Most elements reserved up front for a count read from the file (a million: 80 MB of vertices).
+// Most elements reserved up front for a count read from the file (a million: 88 MB of vertices).
 constexpr std::size_t kReserveLimit = std::size_t{1} << 20;
 }  // namespace
 
