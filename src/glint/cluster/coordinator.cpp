@@ -112,7 +112,9 @@ class Assembly {
   std::size_t done_;  // tiles finished, resumed ones included
 };
 
-int tilesInFlightPerWorker(int threads) { return 2 * std::max(threads, 1) + 1; }
+// `threads` is what a rank's Hello says (up to 4096 from a real worker); clamped so that no Hello
+// can overflow the count.
+int tilesInFlightPerWorker(int threads) { return 2 * std::clamp(threads, 1, 1 << 20) + 1; }
 
 Coordinator::Coordinator(Session& session, std::filesystem::path sceneFile, int threads,
                          const std::atomic<int>* cancelSignal)
@@ -152,6 +154,19 @@ void Coordinator::failWith(const std::string& message) {
   throw JobError(JobFailure::Failure, message);
 }
 
+template <class Decode>
+auto Coordinator::readFrom(int rank, Decode decode) {
+  try {
+    return decode();
+  } catch (const ProtocolError& error) {
+    // A message of the right tag but the wrong layout (a peer of another build that passed the
+    // Hello, or damage): the run fails as for a lost rank — workers stopped, the rank named —
+    // rather than the error leaving the coordinator past its clean-up.
+    failWith(
+        fmt::format("a message from {} could not be read: {}", describeRank(rank), error.what()));
+  }
+}
+
 bool Coordinator::release(int status) {
   const bool orderly = !lost_ && !interrupted_;
   stopWorkers(StopOrder{status, orderly});
@@ -174,7 +189,7 @@ bool Coordinator::awaitHellos(const RankIdentity& mine, const std::atomic<bool>*
     switch (message->tag) {
       case Tag::Hello: {
         if (worker.greeted) break;
-        worker.identity = decodeIdentity(message->bytes);
+        worker.identity = readFrom(rank, [&] { return decodeIdentity(message->bytes); });
         worker.greeted = true;
         --waiting;
         if (const std::optional<std::string> difference =
@@ -190,7 +205,7 @@ bool Coordinator::awaitHellos(const RankIdentity& mine, const std::atomic<bool>*
       }
       case Tag::Leaving:
         failWith(fmt::format("{} stopped before rendering: {}", describeRank(rank),
-                             decodeLeaving(message->bytes).reason));
+                             readFrom(rank, [&] { return decodeLeaving(message->bytes); }).reason));
       case Tag::Silent:
       case Tag::Unreachable:
         failWith(fmt::format("{} {}", describeRank(rank), lostText(message->tag)));
@@ -371,13 +386,14 @@ void Coordinator::render(const Scene& scene, const RenderOptions& options, Film&
       if (!message) continue;
       Worker& worker = workers_[static_cast<std::size_t>(message->peer)];
       if (message->tag == Tag::Report && !worker.finished) {
-        worker.report = decodeReport(message->bytes);
+        worker.report = readFrom(message->peer, [&] { return decodeReport(message->bytes); });
         worker.finished = true;
         link.forget(message->peer);
         --reporting;
       } else if (message->tag == Tag::Leaving) {
-        failWith(fmt::format("{} did not report after the last tile: {}",
-                             describeRank(message->peer), decodeLeaving(message->bytes).reason));
+        failWith(fmt::format(
+            "{} did not report after the last tile: {}", describeRank(message->peer),
+            readFrom(message->peer, [&] { return decodeLeaving(message->bytes); }).reason));
       } else if (message->tag == Tag::Silent || message->tag == Tag::Unreachable) {
         failWith(fmt::format("{} did not report after the last tile: it {}",
                              describeRank(message->peer), lostText(message->tag)));

@@ -82,6 +82,9 @@ class Coordinator {
   bool awaitHellos(const RankIdentity& mine, const std::atomic<bool>* cancel);
   void stopWorkers(const StopOrder& order);
   [[noreturn]] void failWith(const std::string& message);
+  // decode(), or failWith naming `rank` when it throws ProtocolError.
+  template <class Decode>
+  auto readFrom(int rank, Decode decode);
   std::string describeRank(int rank) const;
   // Why a rank the link reported (Tag::Silent or Tag::Unreachable) is lost.
   std::string lostText(Tag tag) const;

@@ -215,6 +215,12 @@ RankReport decodeReport(std::string_view bytes) {
   report.idleSeconds = r.f64();
   report.bytesSent = r.u64();
   r.end();
+  // Durations a rank could have measured (a century at most): they are printed and summed.
+  for (const double seconds : {report.renderSeconds, report.busySeconds, report.idleSeconds}) {
+    if (!(seconds >= 0 && seconds <= 3.2e9)) {
+      throw ProtocolError("a Report holds an impossible duration");
+    }
+  }
   return report;
 }
 

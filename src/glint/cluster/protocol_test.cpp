@@ -92,6 +92,13 @@ TEST(ClusterProtocol, MalformedMessagesAreRefused) {
   EXPECT_THROW(decodeTile(tile.substr(0, tile.size() - 1)), ProtocolError);
   EXPECT_THROW(decodeIdentity(encodeIdentity(sampleIdentity()) + "x"), ProtocolError);
   EXPECT_THROW(decodeStop(""), ProtocolError);
+  // Durations no rank measures (they are printed and summed): refused.
+  for (const double seconds : {-1.0, 1e19, std::numeric_limits<double>::infinity(),
+                               std::numeric_limits<double>::quiet_NaN()}) {
+    RankReport report;
+    report.busySeconds = seconds;
+    EXPECT_THROW(decodeReport(encodeReport(report)), ProtocolError) << seconds;
+  }
 }
 
 TEST(ClusterProtocol, IdentityDifferenceNamesWhatDiffers) {

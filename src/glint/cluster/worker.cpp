@@ -195,7 +195,14 @@ int serveTiles(Session& session, const RenderJobSpec& spec) {
         // Rank 0 assigns tiles only once every rank's identity agreed with its own.
         if (!loaded.scene) break;
         if (!render) render.emplace(*loaded.scene, spec, loaded.region, link);
-        render->add(decodeTiles(message->bytes));
+        try {
+          render->add(decodeTiles(message->bytes));
+        } catch (const ProtocolError& error) {
+          // A damaged or foreign Assign: rank 0 hears why, as for a failed render.
+          render->end(true);
+          return leave(
+              Leaving{0, fmt::format("a tile assignment could not be read: {}", error.what())}, 1);
+        }
         break;
       case Tag::Done: {
         if (render) render->end(false);
@@ -209,7 +216,12 @@ int serveTiles(Session& session, const RenderJobSpec& spec) {
         return session.finish(sent ? 0 : 1, sent);
       }
       case Tag::Stop: {
-        const StopOrder order = decodeStop(message->bytes);
+        // An unreadable Stop still stops this rank, as an unorderly one with status 1.
+        StopOrder order{1, false};
+        try {
+          order = decodeStop(message->bytes);
+        } catch (const ProtocolError&) {
+        }
         if (render) render->end(true);
         // An orderly stop (a refused rank, rank 0's own error) ends every rank with MPI_Finalize;
         // rank 0's status is the job's. A non-zero status here would make mpirun abort the job
