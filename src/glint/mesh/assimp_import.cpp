@@ -355,6 +355,16 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
     // The importer owns the scene and its steps edit it in place; so does dropInvalidFaces.
     result.droppedTriangles = dropInvalidFaces(const_cast<aiScene&>(*scene));
     splitSharedCorners(const_cast<aiScene&>(*scene));
+    // Before Triangulate, whose time grows with the square of a polygon's corners.
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+      const aiMesh* mesh = scene->mMeshes[m];
+      for (unsigned f = 0; mesh != nullptr && f < mesh->mNumFaces; ++f) {
+        if (mesh->mFaces[f].mNumIndices > kMaxFaceCorners) {
+          throw MeshLoadError(fmt::format("a face has {} corners, more than the limit of {}",
+                                          mesh->mFaces[f].mNumIndices, kMaxFaceCorners));
+        }
+      }
+    }
     if (scene->mRootNode == nullptr || facesWithTriangles(*scene) == 0) {
       throw MeshLoadError(result.droppedTriangles > 0
                               ? fmt::format("all {} triangles have vertex indices out of range",

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -81,6 +82,31 @@ TEST(MeshFormatChecks, HeaderCountsTheFileCannotHoldAreRefusedBeforeReading) {
 }
 
 // ------------------------------------------------------------------- hostile files (DESIGN §7)
+
+TEST(MeshFormatChecks, PolygonsOfTooManyCornersAreRefusedBeforeTriangulation) {
+  TempDir dir;
+  // A fuzzing finding: assimp's ASCII PLY reader took 400000 as a face's corner count (for a
+  // uchar list; it makes it 400001 here) and read zeros past the end; triangulating that face
+  // would have taken minutes.
+  EXPECT_THAT(reasonFor(dir.write("fuzz.ply",
+                                  "ply\nformat ascii 1.0\nelement vertex 2\nproperty float y\n"
+                                  "element face 1\nproperty list uchar int vertex_indices\n"
+                                  "end_header\n400000 0")),
+              HasSubstr("corners, more than the limit of 16384"));
+  // A convex polygon of 2000 corners (a disc's cap) is read, as 1998 triangles.
+  std::string disc =
+      "ply\nformat ascii 1.0\nelement vertex 2000\nproperty float x\nproperty float "
+      "y\nproperty float z\nelement face 1\nproperty list int int "
+      "vertex_indices\nend_header\n";
+  for (int i = 0; i < 2000; ++i) {
+    const double angle = 2 * 3.141592653589793 * i / 2000;
+    disc += std::to_string(std::cos(angle)) + " " + std::to_string(std::sin(angle)) + " 0\n";
+  }
+  disc += "2000";
+  for (int i = 0; i < 2000; ++i) disc += " " + std::to_string(i);
+  disc += "\n";
+  EXPECT_EQ(readMeshFile(dir.write("disc.ply", disc)).triangleCount(), 1998u);
+}
 
 TEST(MeshFormatChecks, OnlyTheDocumentedFormatsReachAnImporter) {
   TempDir dir;

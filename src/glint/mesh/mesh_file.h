@@ -26,6 +26,13 @@ namespace glint {
 // mistake or the wrong machine, refused before glint copies the data.
 inline constexpr std::uint64_t kMaxMeshTriangles = std::uint64_t{1} << 28;
 
+// Corners one polygon of a mesh file may have. assimp triangulates a polygon in time quadratic in
+// its corners (a 40,000-corner face: 0.8 s, 400,000: past the reader's 30 s), and its ASCII PLY
+// reader takes any list count, reading zeros past the end of the file: a 2 KB file made a
+// 400,000-corner face. Real models' polygons (caps of cylinders, n-gons of modellers) have tens
+// to a few thousand corners.
+inline constexpr std::uint32_t kMaxFaceCorners = 16384;
+
 // Crease angle of generated smooth normals (degrees; assimp's GenSmoothNormals): the normal at a
 // corner of a triangle averages the normals of the triangles around that vertex whose normals are
 // within this angle of the corner's own triangle. Edges sharper than it — a box's 90° edges — stay
