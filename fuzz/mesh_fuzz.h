@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -23,6 +24,7 @@
 #include <system_error>
 
 #include "glint/core/transform.h"
+#include "glint/mesh/import_child.h"
 #include "glint/mesh/mesh_loader.h"
 
 namespace glint::fuzz {
@@ -42,6 +44,11 @@ inline const std::filesystem::path& workFolder() {
     if (!std::filesystem::is_directory(base, error)) base = std::filesystem::temp_directory_path();
     std::filesystem::path path = base / ("glint-fuzz-" + std::to_string(::getpid()));
     std::filesystem::create_directories(path);
+    // glint stops a mesh reader that runs past its limit (30 s and more) and refuses the file: a
+    // designed refusal (assimp loops, or reads past a file's end into a huge allocation, on some
+    // malformed files), which the fuzzer's own 10 s per input would report as a timeout. The
+    // readers here get 3 s; inputs this small take milliseconds.
+    glint::setMeshReadTimeLimitForTesting(std::chrono::seconds(3));
     std::atexit([] {
       std::error_code ignored;
       std::filesystem::remove_all(workFolder(), ignored);

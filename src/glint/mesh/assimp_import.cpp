@@ -145,6 +145,13 @@ std::string assimpReason(std::string_view message) {
     message.remove_suffix(1);
   }
   if (message.empty()) return "the mesh library could not read it";
+  // assimp reports an allocation that failed by the exception's name; the mesh reader's address
+  // space is capped by the file's size (mesh_reader_side.cpp), so a file that claims more than it
+  // holds ends here.
+  if (message.find("bad_alloc") != std::string_view::npos) {
+    return "not enough memory to read it (the mesh reader may use 512 MiB plus 256 bytes per byte "
+           "of the file, and this file asks for more: damaged or malformed counts?)";
+  }
   return "invalid file: " + std::string(message);
 }
 
@@ -434,7 +441,9 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
                       fileTriangles));
     }
   } catch (const std::bad_alloc&) {
-    throw MeshLoadError("not enough memory to load it");
+    throw MeshLoadError(
+        "not enough memory to read it (the mesh reader may use 512 MiB plus 256 bytes per byte "
+        "of the file, and this file asks for more: damaged or malformed counts?)");
   } catch (const MeshLoadError&) {
     throw;
   } catch (const std::exception& e) {  // an importer's exception that escaped assimp

@@ -61,6 +61,9 @@ constexpr int kCancelPollMilliseconds = 20;
 
 // The test hook's delay of the child (setImportChildDelayForTesting), in milliseconds.
 std::atomic<std::int64_t> gChildDelayMilliseconds{0};
+// The test hook's time limit of the child (setMeshReadTimeLimitForTesting), in milliseconds; 0:
+// meshReadTimeLimit's rule.
+std::atomic<std::int64_t> gReadLimitMilliseconds{0};
 
 // Reads the child's answer, waiting at most until `deadline` for it: a reader that loops (as
 // assimp's importers have on malformed files) must not hang glint. While waiting and between
@@ -213,6 +216,9 @@ MeshFile receiveMeshFile(Reader& in) {
 // How long the child may take: kMeshReadBaseSeconds plus kMeshReadSecondsPerMiB per MiB of the
 // file — assimp reads a 85 MB OBJ in ~2.5 s here, so the limit only ends a reader that loops.
 std::chrono::steady_clock::duration meshReadTimeLimit(const std::filesystem::path& path) {
+  if (const std::int64_t forced = gReadLimitMilliseconds.load(); forced > 0) {
+    return std::chrono::milliseconds(forced);
+  }
   std::error_code error;
   const std::uintmax_t size = std::filesystem::file_size(path, error);
   const double mib = error ? 0 : static_cast<double>(size) / (1024.0 * 1024.0);
@@ -229,6 +235,10 @@ std::chrono::steady_clock::duration meshReadTimeLimit(const std::filesystem::pat
 
 void setImportChildDelayForTesting(std::chrono::milliseconds delay) {
   gChildDelayMilliseconds.store(delay.count());
+}
+
+void setMeshReadTimeLimitForTesting(std::chrono::milliseconds limit) {
+  gReadLimitMilliseconds.store(limit.count());
 }
 
 namespace {

@@ -42,5 +42,9 @@ int runMeshReader(int argc, char** argv);
 // For tests of the parent's waiting (cancellation, time limit): every child started from now on
 // sleeps `delay` before it reads the file; zero turns it off.
 void setImportChildDelayForTesting(std::chrono::milliseconds delay);
+// Test hook: the child's time limit instead of kMeshReadBaseSeconds + kMeshReadSecondsPerMiB per
+// MiB (0: that rule again). The mesh fuzzers use a few seconds, so that a file assimp loops on is
+// refused within their own per-input timeout, as glint refuses it after its limit.
+void setMeshReadTimeLimitForTesting(std::chrono::milliseconds limit);
 
 }  // namespace glint

@@ -2,6 +2,7 @@
 // file with importMesh (assimp, or glint's own OBJ parse) and writes the answer. Its own
 // translation unit so that the renderer, which only starts the reader, does not link assimp.
 #include <malloc.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <system_error>
 
 #include <fmt/format.h>
 
@@ -46,6 +48,45 @@ bool writeMeshFile(int fd, const MeshFile& file) {
 
 }  // namespace wire
 
+namespace {
+
+#if defined(__SANITIZE_ADDRESS__)
+#define GLINT_READER_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define GLINT_READER_UNDER_ASAN 1
+#endif
+#endif
+
+// Caps this process's address space at what it uses now plus 512 MiB plus 256 bytes per byte of
+// the mesh file. assimp's ASCII PLY reader takes any list count and reads zeros past the file's
+// end: a 383-byte file's count of 44294967295 had it fill gigabytes for the whole 30 s limit. With
+// the cap such a file fails in a fraction of a second (std::bad_alloc, "not enough memory");
+// real files need far less (a 100 MB binary PLY, 25 GB allowed). Not under AddressSanitizer,
+// whose shadow memory reserves terabytes of address space (the fuzzers bound the reader's time
+// instead: setMeshReadTimeLimitForTesting).
+void capAddressSpace([[maybe_unused]] const std::filesystem::path& file) {
+#ifndef GLINT_READER_UNDER_ASAN
+  std::error_code error;
+  const std::uintmax_t size = std::filesystem::file_size(file, error);
+  if (error) return;
+  long pages = 0;
+  if (std::FILE* statm = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(statm, "%ld", &pages) != 1) pages = 0;
+    std::fclose(statm);
+  }
+  if (pages <= 0) return;
+  const double cap = static_cast<double>(pages) * static_cast<double>(::sysconf(_SC_PAGESIZE)) +
+                     512.0 * 1024 * 1024 + 256.0 * static_cast<double>(size);
+  if (!(cap < 0x1p62)) return;
+  const auto bytes = static_cast<rlim_t>(cap);
+  const rlimit limit{bytes, bytes};
+  ::setrlimit(RLIMIT_AS, &limit);
+#endif
+}
+
+}  // namespace
+
 int runMeshReader(int argc, char** argv) {
   // Arguments (importMeshInChild): protocol, answer pipe, answer file (-1: none), delay in ms,
   // extension, scene folder, mesh file.
@@ -75,6 +116,7 @@ int runMeshReader(int argc, char** argv) {
     ::nanosleep(&pause, nullptr);
   }
   const std::filesystem::path path = argv[7];
+  capAddressSpace(path);
   MeshFile result;
   std::string error;
   try {
