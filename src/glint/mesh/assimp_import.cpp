@@ -31,6 +31,7 @@
 #include <assimp/Importer.hpp>
 
 #include "glint/core/file_access.h"
+#include "glint/mesh/import_child.h"
 #include "glint/mesh/mesh_repair.h"
 #include "glint/mesh/obj_fast_parse.h"
 #include "glint/scene/scene_limits.h"
@@ -136,6 +137,13 @@ void keepOnlyImporterFor(Assimp::Importer& importer, const std::string& extensio
   }
 }
 
+// Why a file the reader ran out of memory on is refused (kMeshReaderMemory*, import_child.h).
+constexpr std::string_view kNotEnoughMemory =
+    "not enough memory to read it (the mesh reader may use 512 MiB plus 256 bytes per byte of the "
+    "file, and this file asks for more: damaged or malformed counts?)";
+static_assert(kMeshReaderMemoryBaseBytes == 512.0 * 1024 * 1024 &&
+              kMeshReaderMemoryPerFileByte == 256);
+
 // assimp's message in the user's terms.
 std::string assimpReason(std::string_view message) {
   if (message.find("No suitable reader found") != std::string_view::npos) {
@@ -149,8 +157,7 @@ std::string assimpReason(std::string_view message) {
   // space is capped by the file's size (mesh_reader_side.cpp), so a file that claims more than it
   // holds ends here.
   if (message.find("bad_alloc") != std::string_view::npos) {
-    return "not enough memory to read it (the mesh reader may use 512 MiB plus 256 bytes per byte "
-           "of the file, and this file asks for more: damaged or malformed counts?)";
+    return std::string(kNotEnoughMemory);
   }
   return "invalid file: " + std::string(message);
 }
@@ -441,9 +448,7 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
                       fileTriangles));
     }
   } catch (const std::bad_alloc&) {
-    throw MeshLoadError(
-        "not enough memory to read it (the mesh reader may use 512 MiB plus 256 bytes per byte "
-        "of the file, and this file asks for more: damaged or malformed counts?)");
+    throw MeshLoadError(std::string(kNotEnoughMemory));
   } catch (const MeshLoadError&) {
     throw;
   } catch (const std::exception& e) {  // an importer's exception that escaped assimp

@@ -19,6 +19,10 @@ namespace glint {
 // refused (an importer that loops on a malformed file must not hang glint).
 inline constexpr double kMeshReadBaseSeconds = 30;
 inline constexpr double kMeshReadSecondsPerMiB = 2;
+// The mesh reader's address space beyond what it has mapped at start: this much, plus this much
+// per byte of the mesh file (mesh_reader_side.cpp; not for a .gltf, nor under AddressSanitizer).
+inline constexpr double kMeshReaderMemoryBaseBytes = 512.0 * 1024 * 1024;
+inline constexpr double kMeshReaderMemoryPerFileByte = 256;
 
 // importMesh (assimp_import.h) run in a child process; the parent checks the answer (sizes,
 // indices, materials) before returning it. A crash of the child, an answer cut short or

@@ -80,7 +80,8 @@ void capAddressSpace([[maybe_unused]] const std::filesystem::path& file,
   }
   if (pages <= 0) return;
   const double cap = static_cast<double>(pages) * static_cast<double>(::sysconf(_SC_PAGESIZE)) +
-                     512.0 * 1024 * 1024 + 256.0 * static_cast<double>(size);
+                     kMeshReaderMemoryBaseBytes +
+                     kMeshReaderMemoryPerFileByte * static_cast<double>(size);
   if (!(cap < 0x1p62)) return;
   const auto bytes = static_cast<rlim_t>(cap);
   const rlimit limit{bytes, bytes};
