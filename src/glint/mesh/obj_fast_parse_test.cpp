@@ -333,6 +333,81 @@ TEST(ObjFastParse, FilesOutsideTheSubsetAreLeftToAssimp) {
   }
 }
 
+// Whether two parses are the same to the bit (both refused, or the same arrays and name).
+bool sameParse(const std::optional<SimpleObj>& a, const std::optional<SimpleObj>& b) {
+  if (a.has_value() != b.has_value()) return false;
+  if (!a) return true;
+  return sameBits(a->positions, b->positions) && sameBits(a->normals, b->normals) &&
+         sameBits(a->texcoords, b->texcoords) && a->texcoordDimension == b->texcoordDimension &&
+         a->faceSizes == b->faceSizes && a->vertexIndices == b->vertexIndices &&
+         a->texcoordIndices == b->texcoordIndices && a->normalIndices == b->normalIndices &&
+         a->objectName == b->objectName;
+}
+
+TEST(ObjFastParse, AnyCutIntoPiecesParsesAsTheWholeText) {
+  // parseSimpleObj cuts a large file into pieces parsed side by side: every way of cutting, on
+  // one thread or two, must give the whole text's answer. Besides the subset's files, those whose
+  // answer hangs on an earlier line: a `vt` line before a textured face, an object name before the
+  // first face, one corner form in the whole file.
+  const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  const std::pair<const char*, std::string> texts[] = {
+      {"torus", torusObj({.major = 12, .minor = 6})},
+      {"torus_uvs_crlf", torusObj({.major = 8, .minor = 5, .uvs = true, .newline = "\r\n"})},
+      {"torus_quads_no_last_newline",
+       torusObj({.major = 8, .minor = 5, .normals = false, .quads = true, .lastNewline = false})},
+      {"vt_pieces_before_the_face", triangle + "vn 0 0 1\nvt 0 0\n\n\n\nf 1/1/1 2/1/1 3/1/1\n"},
+      {"vt_after_the_face", triangle + "vn 0 0 1\nf 1/1/1 2/1/1 3/1/1\n\n\n\nvt 0 0\n"},
+      {"name_after_vertices", triangle + "# a comment\n\n\no the_name\nf 1 2 3\n"},
+      {"name_after_a_face", triangle + "f 1 2 3\n\n\n\no late\nf 1 2 3\n"},
+      {"second_name", "o first\n\n\n" + triangle + "o second\nf 1 2 3\n"},
+      {"forms_differ_far_apart", triangle + "vn 0 0 1\nf 1//1 2//1 3//1\n\n\n\nf 1 2 3\n"},
+      {"forms_agree_far_apart", triangle + "vn 0 0 1\nf 1//1 2//1 3//1\n\n\n\nf 3//1 2//1 1//1\n"},
+      {"forward_reference", "f 1 2 3\n\n\n\n" + triangle},
+      {"bad_line_last", triangle + "f 1 2 3\n\n\n\ng group\n"},
+      {"index_past_the_end_first", "f 1 2 9\n\n\n\n" + triangle + "f 1 2 3\n"},
+  };
+  for (const auto& [name, text] : texts) {
+    const std::optional<SimpleObj> whole = parseSimpleObjInChunks(text, 1, 1);
+    const auto lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+    for (std::size_t pieces = 2; pieces <= lines + 2; ++pieces) {
+      for (const unsigned threads : {1u, 2u}) {
+        EXPECT_TRUE(sameParse(parseSimpleObjInChunks(text, pieces, threads), whole))
+            << name << " in " << pieces << " pieces on " << threads << " threads";
+      }
+    }
+  }
+  // The expected answers themselves.
+  const auto whole = [&](const std::string& text) { return parseSimpleObjInChunks(text, 1, 1); };
+  EXPECT_TRUE(whole(texts[3].second).has_value());
+  EXPECT_FALSE(whole(texts[4].second).has_value());
+  ASSERT_TRUE(whole(texts[5].second).has_value());
+  EXPECT_EQ(whole(texts[5].second)->objectName, "the_name");
+  EXPECT_FALSE(whole(texts[6].second).has_value());
+  EXPECT_FALSE(whole(texts[7].second).has_value());
+  EXPECT_FALSE(whole(texts[8].second).has_value());
+  EXPECT_TRUE(whole(texts[9].second).has_value());
+  EXPECT_TRUE(whole(texts[10].second).has_value());
+  EXPECT_FALSE(whole(texts[11].second).has_value());
+  EXPECT_FALSE(whole(texts[12].second).has_value());
+  // The benchmark torus at 100k triangles (7.5 MB) in four pieces on two threads.
+  const std::string torus = torusObj({.major = 500, .minor = 100});
+  EXPECT_TRUE(sameParse(parseSimpleObjInChunks(torus, 4, 2), parseSimpleObj(torus, 1)));
+  // A file past twice kParallelParseBytes is cut by parseSimpleObj itself, given threads.
+  std::string large;
+  for (int i = 0; large.size() < 2 * kParallelParseBytes + 100; ++i) {
+    large += "v " + std::to_string(i % 1000) + " " + std::to_string(i / 1000) + " 0.5\n";
+  }
+  large += "vt 0 1\n";
+  for (int i = 1; i + 2 < 1000; i += 3) {
+    large += "f " + std::to_string(i) + "/1 " + std::to_string(i + 1000) + "/1 " +
+             std::to_string(i + 2) + "/1\n";
+  }
+  const std::optional<SimpleObj> serial = parseSimpleObj(large, 1);
+  ASSERT_TRUE(serial.has_value());
+  EXPECT_TRUE(sameParse(parseSimpleObj(large, 3), serial));
+  EXPECT_EQ(serial->faceSizes.size(), 333u);
+}
+
 TEST(ObjFastParse, ParsesNumbersWithAssimpsRoutine) {
   // assimp's float parse rounds the integer and the fraction apart: "1.00200814" becomes
   // 1.0020082, one unit in the last place above the nearest float, 1.00200808 (strtof's). The
