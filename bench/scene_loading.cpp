@@ -126,10 +126,6 @@ double median(std::vector<double> v) {
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
-// The threads glint's OBJ parser may use in the phases below: the machine's, as the mesh reader
-// gets them from a render without --threads.
-const unsigned kParseThreads = static_cast<unsigned>(glint::bench::hardwareThreads());
-
 // One phase of loading `obj` in this process (the --phase mode), its seconds; negative when it
 // fails. "read": the file into memory; "parse": assimp's ReadFile, or the bytes read (untimed) and
 // parseSimpleObj; "import": importMeshWithAssimp or importSimpleObj.
@@ -150,14 +146,12 @@ double runPhase(const std::string& phase, bool useAssimp, const fs::path& obj) {
   if (phase == "parse") {
     const std::string text = readText();
     glint::bench::Stopwatch parse;
-    return glint::parseSimpleObj(text, kParseThreads) ? parse.seconds() : -1;
+    return glint::parseSimpleObj(text) ? parse.seconds() : -1;
   }
   if (phase == "import" && useAssimp) {
     return glint::importMeshWithAssimp(obj, ".obj", rule).parts.empty() ? -1 : watch.seconds();
   }
-  if (phase == "import") {
-    return glint::importSimpleObj(obj, rule, kParseThreads) ? watch.seconds() : -1;
-  }
+  if (phase == "import") return glint::importSimpleObj(obj, rule) ? watch.seconds() : -1;
   return -1;
 }
 

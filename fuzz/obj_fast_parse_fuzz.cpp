@@ -2,9 +2,7 @@
 // (in glint it runs in the import child, where a crash would only refuse the file and so go
 // unseen by mesh_obj_fuzz). What it takes must be consistent (indices within the arrays, faces of
 // 3 or more corners, one corner form); and then, differentially, the mesh glint makes of it must
-// be the one assimp's OBJ importer makes, to the bit, or both must refuse the file. The text cut
-// into pieces (parseSimpleObjInChunks, how a large file is parsed on several threads) must parse
-// as the whole does.
+// be the one assimp's OBJ importer makes, to the bit, or both must refuse the file.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -44,25 +42,11 @@ void requireSame(const glint::MeshFile& a, const glint::MeshFile& b) {
   }
 }
 
-// Whether two parses are the same to the bit.
-bool sameParse(const std::optional<glint::SimpleObj>& a, const std::optional<glint::SimpleObj>& b) {
-  if (a.has_value() != b.has_value()) return false;
-  return !a || (sameBits(a->positions, b->positions) && sameBits(a->normals, b->normals) &&
-                sameBits(a->texcoords, b->texcoords) &&
-                a->texcoordDimension == b->texcoordDimension && a->faceSizes == b->faceSizes &&
-                a->vertexIndices == b->vertexIndices && a->texcoordIndices == b->texcoordIndices &&
-                a->normalIndices == b->normalIndices && a->objectName == b->objectName);
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   const std::optional<glint::SimpleObj> obj = glint::parseSimpleObj(text);
-  // A large file is parsed in pieces side by side: any cut must answer as the whole text does.
-  for (const std::size_t pieces : {2, 3, 7}) {
-    require(sameParse(glint::parseSimpleObjInChunks(text, pieces, pieces == 2 ? 2 : 1), obj));
-  }
   if (!obj) return 0;
   std::size_t corners = 0;
   for (const std::uint32_t n : obj->faceSizes) {

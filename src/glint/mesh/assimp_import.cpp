@@ -460,7 +460,7 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
 }  // namespace
 
 std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
-                                        const ReferencedFileRule& rule, unsigned threads) {
+                                        const ReferencedFileRule& rule) {
   try {
     // The bytes, opened as assimp's importers open the file (MeshFileAccess) and mapped rather
     // than copied: reading them into fresh memory costs a page fault per 4 KiB, mapping them
@@ -478,7 +478,7 @@ std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
       void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd, 0);
       if (mapped == MAP_FAILED) return std::nullopt;
       try {
-        obj = parseSimpleObj(std::string_view(static_cast<const char*>(mapped), size), threads);
+        obj = parseSimpleObj(std::string_view(static_cast<const char*>(mapped), size));
       } catch (...) {
         ::munmap(mapped, size);
         throw;
@@ -527,11 +527,9 @@ MeshFile importMeshWithAssimp(const std::filesystem::path& path, const std::stri
 }
 
 MeshFile importMesh(const std::filesystem::path& path, const std::string& extension,
-                    const ReferencedFileRule& rule, unsigned threads) {
+                    const ReferencedFileRule& rule) {
   if (extension == ".obj" && !objFastPathDisabled()) {
-    if (std::optional<MeshFile> file = importSimpleObj(path, rule, threads)) {
-      return std::move(*file);
-    }
+    if (std::optional<MeshFile> file = importSimpleObj(path, rule)) return std::move(*file);
   }
   return importMeshWithAssimp(path, extension, rule);
 }

@@ -17,17 +17,15 @@ namespace glint {
 // `extension` is the file's checked extension (checkedExtension); `rule` the folder tree of the
 // files it names. Throws MeshLoadError. An OBJ file goes through importSimpleObj first, unless
 // GLINT_OBJ_READER=assimp (objFastPathDisabled); what it does not take, importMeshWithAssimp reads.
-// `threads`: how many threads glint's OBJ parser may use (parseSimpleObj); the result is the same
-// for any count.
 MeshFile importMesh(const std::filesystem::path& path, const std::string& extension,
-                    const ReferencedFileRule& rule, unsigned threads = 1);
+                    const ReferencedFileRule& rule);
 
 // An OBJ file of the plain subset (obj_fast_parse.h) read by glint's parser and then converted as
 // importMeshWithAssimp converts assimp's scene (the same post-processing and repairs): the same
 // MeshFile. Nothing for a file outside the subset or one that fails (the caller then lets assimp
 // read it, and report the failure in its words).
 std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
-                                        const ReferencedFileRule& rule, unsigned threads = 1);
+                                        const ReferencedFileRule& rule);
 
 // importMesh with assimp's own importer for the extension, whatever the file.
 MeshFile importMeshWithAssimp(const std::filesystem::path& path, const std::string& extension,

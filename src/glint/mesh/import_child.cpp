@@ -29,7 +29,6 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <tbb/global_control.h>
 
 #include "glint/core/cancel.h"
 #include "glint/core/file_access.h"
@@ -256,12 +255,6 @@ std::filesystem::path findMeshReader() {
                         GLINT_HELPER_INSTALL_PATH_OR_EMPTY, true);
 }
 
-// The threads this process may use now (the job's --threads, through oneTBB's global control):
-// the reader's OBJ parser may use as many.
-std::size_t allowedThreads() {
-  return tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
-}
-
 // Found once per process.
 const std::filesystem::path& meshReader() {
   static const std::filesystem::path found = findMeshReader();
@@ -323,7 +316,6 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
                                               std::to_string(fds[1]),
                                               std::to_string(answer),
                                               std::to_string(gChildDelayMilliseconds.load()),
-                                              std::to_string(allowedThreads()),
                                               extension,
                                               sceneFolder.string(),
                                               path.string()};

@@ -5,7 +5,6 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -94,8 +93,8 @@ void capAddressSpace([[maybe_unused]] const std::filesystem::path& file,
 
 int runMeshReader(int argc, char** argv) {
   // Arguments (importMeshInChild): protocol, answer pipe, answer file (-1: none), delay in ms,
-  // threads, extension, scene folder, mesh file.
-  if (argc != 9) {
+  // extension, scene folder, mesh file.
+  if (argc != 8) {
     std::fprintf(stderr, "%s: glint starts this program to read mesh files; it is not run alone\n",
                  argc > 0 ? argv[0] : kMeshReaderProgram);
     return 2;
@@ -120,16 +119,12 @@ int runMeshReader(int argc, char** argv) {
     const timespec pause{static_cast<time_t>(delay / 1000), (delay % 1000) * 1000000};
     ::nanosleep(&pause, nullptr);
   }
-  // The threads the renderer may use (its --threads): the OBJ parser cuts a large file into that
-  // many pieces at most. Each thread's heap and stack fit well within the address-space cap,
-  // which grows by 512 MiB per 2 MiB piece.
-  const auto threads = static_cast<unsigned>(std::clamp(std::atol(argv[5]), 1L, 256L));
-  const std::filesystem::path path = argv[8];
-  capAddressSpace(path, argv[6]);
+  const std::filesystem::path path = argv[7];
+  capAddressSpace(path, argv[5]);
   MeshFile result;
   std::string error;
   try {
-    result = importMesh(path, argv[6], ReferencedFileRule(path, argv[7]), threads);
+    result = importMesh(path, argv[5], ReferencedFileRule(path, argv[6]));
   } catch (const MeshLoadError& e) {
     error = e.what();
   } catch (...) {

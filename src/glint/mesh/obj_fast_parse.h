@@ -6,7 +6,6 @@
 // renderer's own process.
 #pragma once
 
-#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -37,19 +36,8 @@ struct SimpleObj {
 // number or index in another spelling, a relative or out-of-range index, corner forms that differ
 // from face to face, a line continuation, a carriage return not before a line feed, a NUL. The
 // numbers are parsed by assimp's own routine (fast_atof.h), so positions, normals and texture
-// coordinates are the same floats to the bit. A text of at least 2 × kParallelParseBytes is
-// cut at line starts into pieces of kParallelParseBytes or more, up to `threads` of them, parsed
-// side by side on that many threads (oneTBB) and joined: the result is the same for any count.
-// (Smaller texts gained nothing measurable: a second thread's start, its fresh heap pages and the
-// join cost about what it saved on the 7.9 MB OBJ of a 100k-triangle torus.)
-std::optional<SimpleObj> parseSimpleObj(std::string_view text, unsigned threads = 1);
-inline constexpr std::size_t kParallelParseBytes = std::size_t{8} << 20;
-
-// parseSimpleObj's work with the text cut into `chunkCount` pieces (fewer when it has fewer
-// lines), parsed on up to `threads` threads; the same result for any counts (the tests and the
-// fuzzer hold it to that).
-std::optional<SimpleObj> parseSimpleObjInChunks(std::string_view text, std::size_t chunkCount,
-                                                unsigned threads);
+// coordinates are the same floats to the bit.
+std::optional<SimpleObj> parseSimpleObj(std::string_view text);
 
 // Whether the OBJ fast path is turned off: the environment variable GLINT_OBJ_READER set to
 // "assimp" (for benchmarks and the differential tests; any other value or none: the fast path).
