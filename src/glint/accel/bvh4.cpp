@@ -123,15 +123,17 @@ struct Binning {
 // binCount bins are initialised and used.
 struct Bins {
   std::array<std::array<Box, kBinCount>, 3> bounds;
-  std::array<std::array<std::uint32_t, kBinCount>, 3> counts;
+  // Per bin, the counts of the three axes in lanes 0–2 (lane 3 unused, 0): one SSE load in the
+  // sweep (bestPlane).
+  alignas(16) std::array<std::array<std::uint32_t, 4>, kBinCount> counts;
   std::array<std::array<double, kBinCount>, 3> costs;
   int binCount;
 
   explicit Bins(int bins) : binCount(bins) {
+    for (int b = 0; b < binCount; ++b) counts[b] = {0, 0, 0, 0};
     for (int axis = 0; axis < 3; ++axis) {
       for (int b = 0; b < binCount; ++b) {
         bounds[axis][b] = Box{};
-        counts[axis][b] = 0;
         costs[axis][b] = 0;
       }
     }
@@ -175,7 +177,7 @@ struct Bins {
     for (int axis = 0; axis < 3; ++axis) {
       const int b = std::clamp(bin[axis], 0, binCount - 1);
       bounds[axis][b].grow(itemLo, itemHi);
-      ++counts[axis][b];
+      ++counts[b][axis];
       if constexpr (kWeighted) costs[axis][b] += cost;
     }
   }
@@ -183,7 +185,7 @@ struct Bins {
     for (int axis = 0; axis < 3; ++axis) {
       for (int b = 0; b < binCount; ++b) {
         bounds[axis][b].grow(other.bounds[axis][b]);
-        counts[axis][b] += other.counts[axis][b];
+        counts[b][axis] += other.counts[b][axis];
         costs[axis][b] += other.costs[axis][b];
       }
     }
@@ -243,7 +245,8 @@ void binRange(const BuildItems& items, const Range& range, const Binning& binnin
 // The SAH sweep over the bins of every binned axis: lowers bestCost to the least cost of a plane
 // (halfArea · cost on each side) and sets decision's axis and bin to it; ties keep the first
 // (lowest axis, then lowest bin).
-void bestPlane(const Bins& bins, const Binning& binning, float& bestCost, Decision& decision) {
+void bestPlaneByAxis(const Bins& bins, const Binning& binning, float& bestCost,
+                     Decision& decision) {
   for (int axis = 0; axis < 3; ++axis) {
     if (binning.scale[axis] == 0) continue;
     // Sweep from the right for the high side of every plane, then from the left; the plane
@@ -257,8 +260,8 @@ void bestPlane(const Bins& bins, const Binning& binning, float& bestCost, Decisi
     const int binCount = binning.binCount;
     for (int b = binCount - 1; b > 0; --b) {
       right.grow(bins.bounds[axis][b]);
-      highCount += bins.counts[axis][b];
-      highCost += binning.weighted ? bins.costs[axis][b] : bins.counts[axis][b];
+      highCount += bins.counts[b][axis];
+      highCost += binning.weighted ? bins.costs[axis][b] : bins.counts[b][axis];
       rightArea[b - 1] = halfArea(right);
       rightCount[b - 1] = highCount;
       rightCost[b - 1] = highCost;
@@ -268,13 +271,87 @@ void bestPlane(const Bins& bins, const Binning& binning, float& bestCost, Decisi
     double lowCost = 0;
     for (int b = 0; b < binCount - 1; ++b) {
       left.grow(bins.bounds[axis][b]);
-      lowCount += bins.counts[axis][b];
-      lowCost += binning.weighted ? bins.costs[axis][b] : bins.counts[axis][b];
+      lowCount += bins.counts[b][axis];
+      lowCost += binning.weighted ? bins.costs[axis][b] : bins.counts[b][axis];
       if (lowCount == 0 || rightCount[b] == 0) continue;
       const float cost = halfArea(left) * static_cast<float>(lowCost) +
                          rightArea[b] * static_cast<float>(rightCost[b]);
       if (cost < bestCost) {
         bestCost = cost;
+        decision.axis = axis;
+        decision.bin = b;
+      }
+    }
+  }
+}
+
+// The half areas of three boxes (the three axes' at one plane) in lanes 0–2: their extents
+// transposed into x, y and z registers, so that each multiply serves all three. Lane for lane
+// halfArea's arithmetic (the same products and sums in the same order, 0 where an extent is
+// negative or NaN), so the same floats.
+__m128 halfAreasOfThree(const Box& a, const Box& b, const Box& c) {
+  const __m128 zero = _mm_setzero_ps();
+  __m128 dx = _mm_sub_ps(a.hi, a.lo);
+  __m128 dy = _mm_sub_ps(b.hi, b.lo);
+  __m128 dz = _mm_sub_ps(c.hi, c.lo);
+  __m128 dw = zero;
+  _MM_TRANSPOSE4_PS(dx, dy, dz, dw);  // dx now holds the three boxes' x extents, and so on
+  const __m128 valid = _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(dx, zero), _mm_cmpge_ps(dy, zero)),
+                                  _mm_cmpge_ps(dz, zero));
+  const __m128 area =
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dy), _mm_mul_ps(dy, dz)), _mm_mul_ps(dz, dx));
+  return _mm_and_ps(valid, area);
+}
+
+// bestPlaneByAxis with the three axes swept side by side, for ranges of triangles alone (cost =
+// count, so a side's cost is its count converted to float: the same float as from the double
+// sum, since both conversions round to nearest) of fewer than 2^31 references (counts convert as
+// signed 32-bit integers). The same planes and costs, so the same choice.
+void bestPlane(const Bins& bins, const Binning& binning, std::uint32_t count, float& bestCost,
+               Decision& decision) {
+  if (binning.weighted || count >= 0x80000000u) {
+    bestPlaneByAxis(bins, binning, bestCost, decision);
+    return;
+  }
+  const int planes = binning.binCount - 1;
+  const auto countsAt = [&](int b) {
+    return _mm_load_si128(reinterpret_cast<const __m128i*>(bins.counts[b].data()));
+  };
+  // Plane b puts bins [0, b] on the low side. Per plane, lanes 0–2 = axes: the high side's area
+  // and count from a sweep from the right, then the low side's from the left, and the cost.
+  __m128 rightArea[kBinCount];
+  __m128i rightCount[kBinCount];
+  Box right[3];
+  __m128i highCount = _mm_setzero_si128();
+  for (int b = planes; b > 0; --b) {
+    for (int axis = 0; axis < 3; ++axis) right[axis].grow(bins.bounds[axis][b]);
+    highCount = _mm_add_epi32(highCount, countsAt(b));
+    rightArea[b - 1] = halfAreasOfThree(right[0], right[1], right[2]);
+    rightCount[b - 1] = highCount;
+  }
+  alignas(16) float cost[kBinCount][4];
+  alignas(16) std::int32_t valid[kBinCount][4];
+  Box left[3];
+  __m128i lowCount = _mm_setzero_si128();
+  const __m128i zero = _mm_setzero_si128();
+  for (int b = 0; b < planes; ++b) {
+    for (int axis = 0; axis < 3; ++axis) left[axis].grow(bins.bounds[axis][b]);
+    lowCount = _mm_add_epi32(lowCount, countsAt(b));
+    const __m128 lowSide =
+        _mm_mul_ps(halfAreasOfThree(left[0], left[1], left[2]), _mm_cvtepi32_ps(lowCount));
+    const __m128 highSide = _mm_mul_ps(rightArea[b], _mm_cvtepi32_ps(rightCount[b]));
+    _mm_store_ps(cost[b], _mm_add_ps(lowSide, highSide));
+    // Both sides hold references.
+    _mm_store_si128(reinterpret_cast<__m128i*>(valid[b]),
+                    _mm_andnot_si128(_mm_or_si128(_mm_cmpeq_epi32(lowCount, zero),
+                                                  _mm_cmpeq_epi32(rightCount[b], zero)),
+                                     _mm_set1_epi32(-1)));
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    if (binning.scale[axis] == 0) continue;
+    for (int b = 0; b < planes; ++b) {
+      if (valid[b][axis] != 0 && cost[b][axis] < bestCost) {
+        bestCost = cost[b][axis];
         decision.axis = axis;
         decision.bin = b;
       }
@@ -338,7 +415,7 @@ Decision decide(const BuildItems& items, const Range& range, int depth, bool for
       } else {
         Bins bins(binning.binCount);
         binRange(items, range, binning, bins);
-        bestPlane(bins, binning, bestCost, decision);
+        bestPlane(bins, binning, count, bestCost, decision);
       }
       if (bestCost < kInf) {
         decision.kind = DecisionKind::Sah;
