@@ -330,7 +330,7 @@ void bestPlane(const Bins& bins, const Binning& binning, std::uint32_t count, fl
     rightCount[b - 1] = highCount;
   }
   alignas(16) float cost[kBinCount][4];
-  alignas(16) std::int32_t valid[kBinCount][4];
+  alignas(16) std::int32_t oneSideEmpty[kBinCount][4];  // all ones where a side holds nothing
   Box left[3];
   __m128i lowCount = _mm_setzero_si128();
   const __m128i zero = _mm_setzero_si128();
@@ -341,16 +341,14 @@ void bestPlane(const Bins& bins, const Binning& binning, std::uint32_t count, fl
         _mm_mul_ps(halfAreasOfThree(left[0], left[1], left[2]), _mm_cvtepi32_ps(lowCount));
     const __m128 highSide = _mm_mul_ps(rightArea[b], _mm_cvtepi32_ps(rightCount[b]));
     _mm_store_ps(cost[b], _mm_add_ps(lowSide, highSide));
-    // Both sides hold references.
-    _mm_store_si128(reinterpret_cast<__m128i*>(valid[b]),
-                    _mm_andnot_si128(_mm_or_si128(_mm_cmpeq_epi32(lowCount, zero),
-                                                  _mm_cmpeq_epi32(rightCount[b], zero)),
-                                     _mm_set1_epi32(-1)));
+    _mm_store_si128(
+        reinterpret_cast<__m128i*>(oneSideEmpty[b]),
+        _mm_or_si128(_mm_cmpeq_epi32(lowCount, zero), _mm_cmpeq_epi32(rightCount[b], zero)));
   }
   for (int axis = 0; axis < 3; ++axis) {
     if (binning.scale[axis] == 0) continue;
     for (int b = 0; b < planes; ++b) {
-      if (valid[b][axis] != 0 && cost[b][axis] < bestCost) {
+      if (oneSideEmpty[b][axis] == 0 && cost[b][axis] < bestCost) {
         bestCost = cost[b][axis];
         decision.axis = axis;
         decision.bin = b;
