@@ -242,49 +242,6 @@ void binRange(const BuildItems& items, const Range& range, const Binning& binnin
       });
 }
 
-// The SAH sweep over the bins of every binned axis: lowers bestCost to the least cost of a plane
-// (halfArea · cost on each side) and sets decision's axis and bin to it; ties keep the first
-// (lowest axis, then lowest bin).
-void bestPlaneByAxis(const Bins& bins, const Binning& binning, float& bestCost,
-                     Decision& decision) {
-  for (int axis = 0; axis < 3; ++axis) {
-    if (binning.scale[axis] == 0) continue;
-    // Sweep from the right for the high side of every plane, then from the left; the plane
-    // after bin b puts bins [0, b] on the low side.
-    std::array<float, kBinCount> rightArea{};
-    std::array<std::uint32_t, kBinCount> rightCount{};
-    std::array<double, kBinCount> rightCost{};
-    Box right;
-    std::uint32_t highCount = 0;
-    double highCost = 0;
-    const int binCount = binning.binCount;
-    for (int b = binCount - 1; b > 0; --b) {
-      right.grow(bins.bounds[axis][b]);
-      highCount += bins.counts[b][axis];
-      highCost += binning.weighted ? bins.costs[axis][b] : bins.counts[b][axis];
-      rightArea[b - 1] = halfArea(right);
-      rightCount[b - 1] = highCount;
-      rightCost[b - 1] = highCost;
-    }
-    Box left;
-    std::uint32_t lowCount = 0;
-    double lowCost = 0;
-    for (int b = 0; b < binCount - 1; ++b) {
-      left.grow(bins.bounds[axis][b]);
-      lowCount += bins.counts[b][axis];
-      lowCost += binning.weighted ? bins.costs[axis][b] : bins.counts[b][axis];
-      if (lowCount == 0 || rightCount[b] == 0) continue;
-      const float cost = halfArea(left) * static_cast<float>(lowCost) +
-                         rightArea[b] * static_cast<float>(rightCost[b]);
-      if (cost < bestCost) {
-        bestCost = cost;
-        decision.axis = axis;
-        decision.bin = b;
-      }
-    }
-  }
-}
-
 // The half areas of three boxes (the three axes' at one plane) in lanes 0–2: their extents
 // transposed into x, y and z registers, so that each multiply serves all three. Lane for lane
 // halfArea's arithmetic (the same products and sums in the same order, 0 where an extent is
@@ -303,43 +260,60 @@ __m128 halfAreasOfThree(const Box& a, const Box& b, const Box& c) {
   return _mm_and_ps(valid, area);
 }
 
-// bestPlaneByAxis with the three axes swept side by side, for ranges of triangles alone (cost =
-// count, so a side's cost is its count converted to float: the same float as from the double
-// sum, since both conversions round to nearest) of fewer than 2^31 references (counts convert as
-// signed 32-bit integers). The same planes and costs, so the same choice.
+// The SAH sweep over the bins of every binned axis: lowers bestCost to the least cost of a plane
+// (halfArea · cost on each side) and sets decision's axis and bin to it; ties keep the first
+// (lowest axis, then lowest bin). The three axes are swept side by side, one SSE lane each. A
+// side's cost is the sum of its bins' costs, converted to float: for a range of triangles alone
+// of fewer than 2^31 references (the counts convert as signed 32-bit integers) its count,
+// converted in the register — the same float as through the double sum, since both conversions
+// round to nearest.
 void bestPlane(const Bins& bins, const Binning& binning, std::uint32_t count, float& bestCost,
                Decision& decision) {
-  if (binning.weighted || count >= 0x80000000u) {
-    bestPlaneByAxis(bins, binning, bestCost, decision);
-    return;
-  }
+  const bool countsAreCosts = !binning.weighted && count < 0x80000000u;
   const int planes = binning.binCount - 1;
   const auto countsAt = [&](int b) {
     return _mm_load_si128(reinterpret_cast<const __m128i*>(bins.counts[b].data()));
   };
-  // Plane b puts bins [0, b] on the low side. Per plane, lanes 0–2 = axes: the high side's area
-  // and count from a sweep from the right, then the low side's from the left, and the cost.
+  // The double sums of a side's costs when they are not its counts (countsAreCosts false).
+  const auto addCosts = [&](int b, std::array<double, 3>& sums) {
+    for (int axis = 0; axis < 3; ++axis) {
+      sums[axis] += binning.weighted ? bins.costs[axis][b] : bins.counts[b][axis];
+    }
+  };
+  const auto sideCost = [&](__m128i counts, const std::array<double, 3>& sums) {
+    return countsAreCosts ? _mm_cvtepi32_ps(counts)
+                          : _mm_setr_ps(static_cast<float>(sums[0]), static_cast<float>(sums[1]),
+                                        static_cast<float>(sums[2]), 0);
+  };
+  // Plane b puts bins [0, b] on the low side. Per plane, lanes 0–2 = axes: the high side's area,
+  // count and cost from a sweep from the right, then the low side's from the left, and the cost.
   __m128 rightArea[kBinCount];
   __m128i rightCount[kBinCount];
+  __m128 rightCost[kBinCount];
   Box right[3];
   __m128i highCount = _mm_setzero_si128();
+  std::array<double, 3> highCost{};
   for (int b = planes; b > 0; --b) {
     for (int axis = 0; axis < 3; ++axis) right[axis].grow(bins.bounds[axis][b]);
     highCount = _mm_add_epi32(highCount, countsAt(b));
+    if (!countsAreCosts) addCosts(b, highCost);
     rightArea[b - 1] = halfAreasOfThree(right[0], right[1], right[2]);
     rightCount[b - 1] = highCount;
+    rightCost[b - 1] = sideCost(highCount, highCost);
   }
   alignas(16) float cost[kBinCount][4];
   alignas(16) std::int32_t oneSideEmpty[kBinCount][4];  // all ones where a side holds nothing
   Box left[3];
   __m128i lowCount = _mm_setzero_si128();
+  std::array<double, 3> lowCost{};
   const __m128i zero = _mm_setzero_si128();
   for (int b = 0; b < planes; ++b) {
     for (int axis = 0; axis < 3; ++axis) left[axis].grow(bins.bounds[axis][b]);
     lowCount = _mm_add_epi32(lowCount, countsAt(b));
+    if (!countsAreCosts) addCosts(b, lowCost);
     const __m128 lowSide =
-        _mm_mul_ps(halfAreasOfThree(left[0], left[1], left[2]), _mm_cvtepi32_ps(lowCount));
-    const __m128 highSide = _mm_mul_ps(rightArea[b], _mm_cvtepi32_ps(rightCount[b]));
+        _mm_mul_ps(halfAreasOfThree(left[0], left[1], left[2]), sideCost(lowCount, lowCost));
+    const __m128 highSide = _mm_mul_ps(rightArea[b], rightCost[b]);
     _mm_store_ps(cost[b], _mm_add_ps(lowSide, highSide));
     _mm_store_si128(
         reinterpret_cast<__m128i*>(oneSideEmpty[b]),
