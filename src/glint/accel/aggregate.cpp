@@ -924,8 +924,8 @@ struct PacketChunk {
   }
   float minOf(unsigned lanes) const {
     const __m256i bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-    const __m256 keep = _mm256_castsi256_ps(_mm256_cmpeq_epi32(
-        _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(lanes)), bit), bit));
+    const __m256 keep = _mm256_castsi256_ps(
+        _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(static_cast<int>(lanes)), bit), bit));
     const __m256 x =
         _mm256_blendv_ps(_mm256_set1_ps(std::numeric_limits<float>::infinity()), v, keep);
     return minOfFour(_mm_min_ps(_mm256_castps256_ps128(x), _mm256_extractf128_ps(x, 1)));
@@ -949,9 +949,9 @@ struct PacketChunk {
     const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
     const __m128 keep = _mm_castsi128_ps(
         _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<int>(lanes)), bit), bit));
-    return minOfFour(_mm_or_ps(
-        _mm_and_ps(keep, v),
-        _mm_andnot_ps(keep, _mm_set1_ps(std::numeric_limits<float>::infinity()))));
+    return minOfFour(
+        _mm_or_ps(_mm_and_ps(keep, v),
+                  _mm_andnot_ps(keep, _mm_set1_ps(std::numeric_limits<float>::infinity()))));
   }
   void store(float* p) const { _mm_storeu_ps(p, v); }
 };
@@ -1148,9 +1148,9 @@ inline bool crossPrimitive(const Primitive& primitive, const Color& kt, const Le
     return !isBlack(result);
   }
   // An untransformed sphere inline, exactly as Primitive::crossings would count it.
-  const int crossings = sphere.radius > 0
-                            ? quadric::sphereCrossings(sphere.center, sphere.radius, ray, tMin, tMax)
-                            : primitive.crossings(ray, tMin, tMax);
+  const int crossings =
+      sphere.radius > 0 ? quadric::sphereCrossings(sphere.center, sphere.radius, ray, tMin, tMax)
+                        : primitive.crossings(ray, tMin, tMax);
   if (crossings == 0) return true;
   if (isBlack(kt)) return false;
   for (int k = 0; k < crossings; ++k) result *= kt;
