@@ -13,6 +13,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <utility>
 
 #include "glint/core/ulp.h"
@@ -497,10 +498,28 @@ Node emptyNode() {
   return node;
 }
 
+// A part of the tree built by one task: its nodes, depth-first, with child indices relative to
+// its start, and the subtrees of its node that were built by tasks of their own (a node over at
+// least kParallelBuildThreshold references builds each inner child's subtree as a task; such a
+// node is the only node of its part, since its parent builds it as a task too). `place` puts
+// every part in its place of the tree's depth-first array at the end: the subtrees are neither
+// copied level by level into their parents' arrays nor copied on one thread.
+struct Part {
+  struct Subtree {
+    std::uint32_t node;  // the node here, and its slot, that points to the subtree
+    int slot;
+    std::unique_ptr<Part> part;
+  };
+  Nodes nodes;
+  std::vector<Subtree> subtrees;  // in slot order: depth-first, they follow nodes in that order
+  std::size_t totalNodes = 0;     // with every subtree's, at all levels (countNodes)
+};
+
 // Appends the subtree of a range that must be split to out (depth-first); returns its root's index
-// in out. Child indices are relative to out's start.
+// in out.nodes. Child indices are relative to out's start; the slots of subtrees built as tasks
+// of their own are set by `place`.
 std::uint32_t buildNode(BuildItems& items, const Range& range, const Decision& decision, int depth,
-                        Nodes& out) {
+                        Part& out) {
   std::array<Child, 4> children;
   int childCount = 1;
   children[0] = {range, decision};
@@ -540,12 +559,12 @@ std::uint32_t buildNode(BuildItems& items, const Range& range, const Decision& d
     children[childCount++] = {right, rightDecision};
   }
 
-  const auto nodeIndex = static_cast<std::uint32_t>(out.size());
-  out.push_back(emptyNode());
+  const auto nodeIndex = static_cast<std::uint32_t>(out.nodes.size());
+  out.nodes.push_back(emptyNode());
   for (int i = 0; i < childCount; ++i) {
     const auto lo = lanes(children[i].range.bounds.lo);
     const auto hi = lanes(children[i].range.bounds.hi);
-    Node& node = out[nodeIndex];
+    Node& node = out.nodes[nodeIndex];
     for (int axis = 0; axis < 3; ++axis) {
       node.bounds[axis][i] = lo[axis];
       node.bounds[axis + 3][i] = hi[axis];
@@ -563,35 +582,61 @@ std::uint32_t buildNode(BuildItems& items, const Range& range, const Decision& d
       if (children[i].decision.leaf) continue;
       const std::uint32_t index =
           buildNode(items, children[i].range, children[i].decision, depth + 1, out);
-      out[nodeIndex].child[i] = index;
+      out.nodes[nodeIndex].child[i] = index;
     }
     return nodeIndex;
   }
-  // The subtrees work on disjoint ranges of items; each is built into its own array and appended in
-  // child order, so the layout is the same as the sequential depth-first one.
-  std::array<Nodes, 4> subtrees;
-  tbb::task_group group;
+  // The subtrees work on disjoint ranges of items, each into its own part.
   for (int i = 0; i < childCount; ++i) {
-    if (children[i].decision.leaf) continue;
-    group.run([&, i] {
-      subtrees[i].reserve(nodeCountGuess(children[i].range.count()));
-      buildNode(items, children[i].range, children[i].decision, depth + 1, subtrees[i]);
+    if (!children[i].decision.leaf) {
+      out.subtrees.push_back({nodeIndex, i, std::make_unique<Part>()});
+    }
+  }
+  tbb::task_group group;
+  for (const Part::Subtree& subtree : out.subtrees) {
+    Part* part = subtree.part.get();
+    const Child* child = &children[subtree.slot];
+    group.run([&items, part, child, depth] {
+      // A part over fewer references than kParallelBuildThreshold holds their whole subtree.
+      if (child->range.count() < kParallelBuildThreshold) {
+        part->nodes.reserve(nodeCountGuess(child->range.count()));
+      }
+      buildNode(items, child->range, child->decision, depth + 1, *part);
     });
   }
   group.wait();
-  for (int i = 0; i < childCount; ++i) {
-    if (children[i].decision.leaf) continue;
-    const auto base = static_cast<std::uint32_t>(out.size());
-    out[nodeIndex].child[i] = base;
-    for (Node node : subtrees[i]) {
-      for (int k = 0; k < 4; ++k) {
-        if (node.info[k] == kInner) node.child[k] += base;
-      }
-      out.push_back(node);
-    }
-    Nodes().swap(subtrees[i]);
-  }
   return nodeIndex;
+}
+
+std::size_t countNodes(Part& part) {
+  part.totalNodes = part.nodes.size();
+  for (Part::Subtree& subtree : part.subtrees) part.totalNodes += countNodes(*subtree.part);
+  return part.totalNodes;
+}
+
+// Copies part (countNodes done) and its subtrees to out[base ...], depth-first: its own nodes,
+// then each subtree after the last; child indices made absolute. Parts are copied in parallel.
+void place(const Part& part, std::uint32_t base, Node* out) {
+  tbb::task_group group;
+  auto next = static_cast<std::uint32_t>(base + part.nodes.size());
+  for (const Part::Subtree& subtree : part.subtrees) {
+    const Part* child = subtree.part.get();
+    group.run([child, next, out] { place(*child, next, out); });
+    next += static_cast<std::uint32_t>(child->totalNodes);
+  }
+  for (std::size_t n = 0; n < part.nodes.size(); ++n) {
+    Node node = part.nodes[n];
+    for (int k = 0; k < 4; ++k) {
+      if (node.info[k] == kInner) node.child[k] += base;
+    }
+    out[base + n] = node;
+  }
+  next = static_cast<std::uint32_t>(base + part.nodes.size());
+  for (const Part::Subtree& subtree : part.subtrees) {
+    out[base + subtree.node].child[subtree.slot] = next;
+    next += static_cast<std::uint32_t>(subtree.part->totalNodes);
+  }
+  group.wait();
 }
 
 Range wholeRange(const BuildItems& items) {
@@ -725,10 +770,17 @@ Tree build(BuildItems& items) {
     tree.rootInfo = leafInfo(itemKey(items[0]), root.count());
     return tree;
   }
-  tree.nodes.reserve(nodeCountGuess(root.count()));
-  tree.rootChild = buildNode(items, root, decision, 0, tree.nodes);
+  Part whole;
+  if (root.count() < kParallelBuildThreshold) whole.nodes.reserve(nodeCountGuess(root.count()));
+  tree.rootChild = buildNode(items, root, decision, 0, whole);
   tree.rootInfo = kInner;
-  tree.nodes.shrink_to_fit();
+  if (whole.subtrees.empty()) {
+    tree.nodes = std::move(whole.nodes);
+    tree.nodes.shrink_to_fit();
+  } else {
+    tree.nodes.resize(countNodes(whole));  // not zeroed (Nodes' allocator): place writes them all
+    place(whole, 0, tree.nodes.data());
+  }
   return tree;
 }
 

@@ -60,10 +60,10 @@ struct alignas(16) BuildItem {
 static_assert(sizeof(BuildItem) == 32);
 // The build's references and nodes are on huge pages (HugePageAllocator): a 1M-triangle build
 // fills ~50 MB of them, and one page fault per 4 KiB took a third of its time here. The
-// references are sized, then written in parallel, each before it is read: not zeroed first
-// (UnzeroedHugePageAllocator).
+// references, and the 4-wide tree's final array, are sized, then written in parallel, each
+// element before it is read: not zeroed first (UnzeroedHugePageAllocator).
 using BuildItems = UnzeroedHugePageArray<BuildItem>;
-using Nodes = HugePageArray<Node>;
+using Nodes = UnzeroedHugePageArray<Node>;
 using Nodes8 = HugePageArray<Node8>;
 
 BuildItem makeBuildItem(const double lo[3], const double hi[3], std::uint32_t key,
