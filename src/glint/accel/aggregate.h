@@ -187,6 +187,8 @@ class Aggregate {
   // normal: the triangle's unnormalised geometric normal (p1 − p0) × (p2 − p0).
   void finishTriangleHit(std::uint32_t mesh, std::uint32_t triangle, const WatertightHit& candidate,
                          const Vec3& normal, Hit& hit) const;
+  // Renumbers the leaves' references and each mesh's triangles and vertices into the leaf order
+  // of items (the build's references).
   void storeInLeafOrder(const bvh::BuildItems& items);
   friend struct AggregateInspector;  // aggregate_test.cpp checks the node layout invariants
 

@@ -1416,6 +1416,14 @@ TEST(AggregateMeshTest, ParallelBuildIsIndependentOfTheThreadCount) {
   EXPECT_EQ(one.triangleCount(), mesh.triangleCount());
   EXPECT_TRUE(AggregateInspector::sameTree(one, two));
   AggregateInspector::check(two);
+  // The mesh as stored, renumbered into leaf order with its vertices by first use (on two threads
+  // numbered in blocks side by side, then merged): the same arrays too.
+  ASSERT_EQ(one.meshes().size(), 1U);
+  ASSERT_EQ(two.meshes().size(), 1U);
+  EXPECT_EQ(one.meshes()[0].indices, two.meshes()[0].indices);
+  EXPECT_TRUE(AggregateInspector::sameBytes(one.meshes()[0].positions, two.meshes()[0].positions));
+  EXPECT_TRUE(AggregateInspector::sameBytes(one.meshes()[0].normals, two.meshes()[0].normals));
+  EXPECT_EQ(one.meshes()[0].positions.size(), mesh.positions.size());  // every vertex is used
   // Memory: mesh (positions, normals, indices) and tree together within 64 bytes per triangle.
   const double bytesPerTriangle =
       static_cast<double>(one.memoryBytes()) / static_cast<double>(one.triangleCount());
