@@ -91,10 +91,12 @@ std::optional<std::int64_t> readIntegerInRange(ParameterDictionary& params, std:
   return v->value;
 }
 
-std::optional<Color> readCoefficient(ParameterDictionary& params, std::string_view key) {
+std::optional<Color> readCoefficient(ParameterDictionary& params, std::string_view key,
+                                     Encoding encoding) {
   const auto v = params.coefficient(key);
   if (!v) return std::nullopt;
-  const Color& c = v->value;
+  if (v->value.isHex) return decodeColor(params, *v, params.pathOf(key).str(), encoding);
+  const Color& c = v->value.rgb;
   if (c.r >= 0 && c.g >= 0 && c.b >= 0) return c;
   params.error(v->where, fmt::format("{} must be >= 0, got {}", params.pathOf(key).str(), show(c)));
   return std::nullopt;

@@ -75,8 +75,10 @@ std::optional<double> readNonNegative(ParameterDictionary& params, std::string_v
 std::optional<std::int64_t> readIntegerInRange(ParameterDictionary& params, std::string_view key,
                                                std::int64_t lo, std::int64_t hi,
                                                Presence presence = Presence::Optional);
-// A number or [r, g, b] with every component >= 0.
-std::optional<Color> readCoefficient(ParameterDictionary& params, std::string_view key);
+// A colour-valued material coefficient (DESIGN.md §9): a number (grey) or [r, g, b] with every
+// component >= 0, or "#rrggbb" decoded as readColor decodes it.
+std::optional<Color> readCoefficient(ParameterDictionary& params, std::string_view key,
+                                     Encoding encoding);
 // The unit vector along a non-zero vector of any length ("{path} must be non-zero, got [0, 0, 0]");
 // tiny and huge components (1e-200, 1e200) are divided by the largest one first, so only a zero
 // vector is refused.

@@ -101,7 +101,7 @@ std::optional<Csg> readOperand(const ValueReader& reader, ValueId value, ValueId
     if (services.emissionTexture) emission = Color();
   }
   if (params.has("emission")) {
-    if (const auto own = readColor(params, "emission", services.encoding)) emission = *own;
+    if (const auto own = readCoefficient(params, "emission", services.encoding)) emission = *own;
   }
   const TransformResult transform = readTransform(params, path);
   std::optional<Csg> result;

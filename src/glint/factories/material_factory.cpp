@@ -24,7 +24,8 @@ const std::vector<std::string_view>& materialKeys() {
   return keys;
 }
 
-std::optional<Material> readMaterial(ParameterDictionary& params, TextureLibrary* textures) {
+std::optional<Material> readMaterial(ParameterDictionary& params, Encoding encoding,
+                                     TextureLibrary* textures) {
   params.declare(materialKeys());
   const std::size_t errorsBefore = params.errors();
   Material out;
@@ -40,7 +41,7 @@ std::optional<Material> readMaterial(ParameterDictionary& params, TextureLibrary
       }
       return;
     }
-    if (const auto c = readCoefficient(params, key)) value = *c;
+    if (const auto c = readCoefficient(params, key, encoding)) value = *c;
   };
   coefficient("kd", out.kd, bindings.kd);
   coefficient("ks", out.ks, bindings.ks);

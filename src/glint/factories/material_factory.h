@@ -8,6 +8,7 @@
 
 #include "glint/readers/parameter_dictionary.h"
 #include "glint/scene/material.h"
+#include "glint/scene/scene.h"
 
 namespace glint {
 
@@ -20,8 +21,9 @@ class TextureLibrary;
 // the wrong type (reported at the value). Absent keys keep Material's defaults. With `textures`,
 // a colour key may name or describe a texture (its constant is then 1, the texture's colour
 // replacing it), and normal_map, bump_map and bump_scale are read; the bindings are added to the
-// scene and indexed by Material::textures.
-std::optional<Material> readMaterial(ParameterDictionary& params,
+// scene and indexed by Material::textures. A colour written "#rrggbb" is decoded under `encoding`
+// (the image's, as every display colour of the scene).
+std::optional<Material> readMaterial(ParameterDictionary& params, Encoding encoding,
                                      TextureLibrary* textures = nullptr);
 
 }  // namespace glint

@@ -147,7 +147,7 @@ class Builder {
                                    {"in material '" + name + "'", path, path});
     std::optional<Material> material;
     if (params) {
-      material = readMaterial(*params, &textures_);
+      material = readMaterial(*params, ctx_.encoding, &textures_);
       params->finish();
     }
     // Kept even when it has errors, so objects naming it do not also report it undefined.
@@ -162,7 +162,7 @@ class Builder {
     if (tree.isMap(entry->value)) {
       const std::string path = owner + ".material";
       ParameterDictionary inline_(reader, entry->value, {"in " + path, path, path});
-      const std::optional<Material> material = readMaterial(inline_, &textures_);
+      const std::optional<Material> material = readMaterial(inline_, ctx_.encoding, &textures_);
       inline_.finish();
       if (!material) return {0, true};
       parts_.materials.push_back(*material);
@@ -361,15 +361,15 @@ class Builder {
 
     MaterialChoice material = resolveMaterial(params, type);
     const bool hasEmission = params.has("emission");
-    // `emission` is a colour, or a texture: then the object's own copy of its material carries it
-    // and the constant is 1.
+    // `emission` is a colour (or a number, grey), or a texture: then the object's own copy of its
+    // material carries it and the constant is 1.
     std::optional<Color> emission;
     std::optional<TextureId> emissionTexture;
     if (textures_.isTexture(params, "emission")) {
       emissionTexture = textures_.read(params, "emission", TextureRole::Color);
       if (emissionTexture) emission = Color(1);
     } else {
-      emission = readColor(params, "emission", ctx_.encoding);
+      emission = readCoefficient(params, "emission", ctx_.encoding);
     }
     const TransformResult transform = readTransform(params, type);
     if (factory == &csgFactory_) {

@@ -196,6 +196,25 @@ TEST(SceneBuilder, HexColorsDecodeUnderTheImageEncoding) {
   // [r, g, b] is linear under either encoding, and may exceed 1.
   EXPECT_EQ(partsOf(std::string(kMinimal) + "background: [0.25, 2, 0]\n").background,
             Color(0.25, 2, 0));
+  // Colour-valued material keys and emission take a number, [r, g, b] or "#rrggbb" alike
+  // (DESIGN.md §9).
+  const std::string material =
+      "materials: {m: {kd: \"#804000\", ks: 0.25, ka: [0.5, 0.25, 0]}}\n"
+      "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1, material: m, emission: 0.5}\n"
+      "camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 40}\n";
+  for (const bool isLinear : {true, false}) {
+    const SceneParts parts =
+        partsOf(material + (isLinear ? "image: {width: 4, height: 3, encoding: linear}\n"
+                                     : "image: {width: 4, height: 3}\n"));
+    const auto decode = [&](int code) {
+      return isLinear ? code / 255.0 : srgbToLinear(code / 255.0);
+    };
+    const Material& m = parts.materials.at(parts.primitives.at(0).materialIndex());
+    EXPECT_EQ(m.kd, Color(decode(128), decode(64), 0));
+    EXPECT_EQ(m.ks, Color(0.25));
+    EXPECT_EQ(m.ka, Color(0.5, 0.25, 0));
+    EXPECT_EQ(parts.primitives.at(0).emission(), Color(0.5));
+  }
 }
 
 TEST(SceneBuilder, DefaultsForOptionalKeys) {
@@ -327,7 +346,11 @@ TEST(SceneBuilder, ValuesOutOfRangeAtTheValue) {
       {"background: [-1, 0, 0]\n", 3, 13, "background components must be >= 0, got [-1, 0, 0]"},
       {"ambient: {color: [1, 1, 1], intensity: -1}\n", 3, 40, "ambient.intensity must be >= 0"},
       {"objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, emission: [0, -1, 0]}\n", 4, 60,
-       "sphere.emission components must be >= 0"},
+       "sphere.emission must be >= 0, got [0, -1, 0]"},
+      {"objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, emission: -1}\n", 4, 60,
+       "sphere.emission must be >= 0, got -1"},
+      {"materials: {m: {kd: \"#12345\"}}\n", 3, 21,
+       "materials.m.kd: expected a color \"#rrggbb\" with 6 hexadecimal digits"},
   };
   for (const Case& c : cases)
     expectOneError(std::string(kMinimal) + c.text, c.line, c.column, c.fragment);

@@ -228,21 +228,23 @@ std::optional<ColorValue> ValueReader::color(ValueId v, ValueId where,
   return out;
 }
 
-std::optional<Color> ValueReader::coefficient(ValueId v, ValueId where,
-                                              const ValuePath& path) const {
+std::optional<ColorValue> ValueReader::coefficient(ValueId v, ValueId where,
+                                                   const ValuePath& path) const {
+  const std::string_view s = tree().scalar(v);
+  if (tree().isScalar(v) && !s.empty() && s[0] == '#') return color(v, where, path);
   if (tree().isScalar(v)) {
     const std::optional<double> n = number(v, where, path);
     if (!n) return std::nullopt;
-    return Color(*n);
+    ColorValue out;
+    out.rgb = Color(*n);
+    return out;
   }
   if (!tree().isList(v)) {
-    error(where, fmt::format("{}: expected a number or a list of 3 numbers [r, g, b], got {}",
+    error(where, fmt::format("{}: expected a number, a color [r, g, b] or \"#rrggbb\", got {}",
                              path.str(), describe(v)));
     return std::nullopt;
   }
-  const auto t = triple(v, where, path, "[r, g, b]");
-  if (!t) return std::nullopt;
-  return Color((*t)[0], (*t)[1], (*t)[2]);
+  return color(v, where, path);
 }
 
 std::optional<std::string_view> ValueReader::text(ValueId v, ValueId where,
@@ -473,7 +475,8 @@ std::optional<Located<std::array<double, 3>>> ParameterDictionary::triple(std::s
 std::optional<Located<ColorValue>> ParameterDictionary::color(std::string_view key, Presence p) {
   return get(key, p, &ValueReader::color);
 }
-std::optional<Located<Color>> ParameterDictionary::coefficient(std::string_view key, Presence p) {
+std::optional<Located<ColorValue>> ParameterDictionary::coefficient(std::string_view key,
+                                                                   Presence p) {
   return get(key, p, &ValueReader::coefficient);
 }
 std::optional<Located<std::string_view>> ParameterDictionary::text(std::string_view key,

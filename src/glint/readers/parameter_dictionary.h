@@ -81,8 +81,8 @@ class ValueReader {
   std::optional<Vec3> vec3(ValueId v, ValueId where, const ValuePath& path) const;
   std::optional<Point3> point3(ValueId v, ValueId where, const ValuePath& path) const;
   std::optional<ColorValue> color(ValueId v, ValueId where, const ValuePath& path) const;
-  // A number (grey) or [r, g, b].
-  std::optional<Color> coefficient(ValueId v, ValueId where, const ValuePath& path) const;
+  // A colour-valued material coefficient: a number (grey), [r, g, b] or "#rrggbb".
+  std::optional<ColorValue> coefficient(ValueId v, ValueId where, const ValuePath& path) const;
   std::optional<std::string_view> text(ValueId v, ValueId where, const ValuePath& path) const;
   // YAML 1.2 core-schema booleans only (true/True/TRUE, false/False/FALSE).
   std::optional<bool> boolean(ValueId v, ValueId where, const ValuePath& path) const;
@@ -158,7 +158,8 @@ class ParameterDictionary {
   std::optional<Located<std::array<double, 3>>> triple(std::string_view key, std::string_view what,
                                                        Presence p = Presence::Optional);
   std::optional<Located<ColorValue>> color(std::string_view key, Presence p = Presence::Optional);
-  std::optional<Located<Color>> coefficient(std::string_view key, Presence p = Presence::Optional);
+  std::optional<Located<ColorValue>> coefficient(std::string_view key,
+                                                 Presence p = Presence::Optional);
   std::optional<Located<std::string_view>> text(std::string_view key,
                                                 Presence p = Presence::Optional);
   std::optional<Located<bool>> boolean(std::string_view key, Presence p = Presence::Optional);
