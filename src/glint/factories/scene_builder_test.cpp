@@ -1245,6 +1245,31 @@ TEST(SceneBuilder, AmbientOcclusionAndIntegratorKeys) {
   const RenderSettings path = build("{integrator: path, min_depth: 5}");
   EXPECT_EQ(path.integrator, Integrator::Path);
   EXPECT_EQ(path.minDepth, 5);
+  // An option of the other integrator is read (and checked) but has no effect: a warning at its
+  // key, for the integrator the render uses (--integrator included).
+  const auto warningsOf = [&](const std::string& render, SceneOverrides overrides = {}) {
+    LoadOptions options;
+    options.overrides = overrides;
+    return loadSceneFromString(base + render + "\n", "t.yaml", ".", options).warnings;
+  };
+  const std::vector<Diagnostic> aoUnderPath =
+      warningsOf("{integrator: path, ambient_occlusion: {samples: 4}}");
+  ASSERT_EQ(aoUnderPath.size(), 1U);
+  EXPECT_EQ(aoUnderPath[0].format(),
+            "t.yaml:3:28: warning: render.ambient_occlusion has no effect: it is an option of the "
+            "whitted integrator, and this render uses path");
+  const std::vector<Diagnostic> minDepthUnderWhitted = warningsOf("{min_depth: 4}");
+  ASSERT_EQ(minDepthUnderWhitted.size(), 1U);
+  EXPECT_THAT(minDepthUnderWhitted[0].format(),
+              HasSubstr("t.yaml:3:10: warning: render.min_depth has no effect: it is an option "
+                        "of the path integrator, and this render uses whitted"));
+  SceneOverrides toPath;
+  toPath.integrator = Integrator::Path;
+  EXPECT_TRUE(warningsOf("{min_depth: 4}", toPath).empty());
+  const std::vector<Diagnostic> aoOverridden = warningsOf("{ambient_occlusion: {}}", toPath);
+  ASSERT_EQ(aoOverridden.size(), 1U);
+  EXPECT_THAT(aoOverridden[0].format(), HasSubstr("this render uses path (--integrator)"));
+  EXPECT_EQ(warningsOf("{ambient_occlusion: {}, min_depth: 2}", toPath).size(), 1U);
   EXPECT_EQ(build("{}").integrator, Integrator::Whitted);
   EXPECT_EQ(build("{}").minDepth, 3);
 }

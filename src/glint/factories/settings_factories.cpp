@@ -192,6 +192,20 @@ void buildRender(const SceneDescription& scene, const Entity& e, BuildContext& c
   }
   if (const auto v = p.unsignedInteger("seed")) render.seed = v->value;
   p.finish();
+  // Each integrator's own option has no effect under the other: a warning at its key (not an
+  // error: a scene may carry both, the integrator then chosen with --integrator).
+  const bool overridden = ctx.options.overrides.integrator.has_value();
+  const Integrator used = ctx.options.overrides.integrator.value_or(render.integrator);
+  const auto unusedOption = [&](std::string_view key, std::string_view owner) {
+    if (!p.has(key)) return;
+    ctx.sink.warning(p.location(p.keyPlace(key)),
+                     fmt::format("render.{} has no effect: it is an option of the {} integrator, "
+                                 "and this render uses {}{}",
+                                 key, owner, used == Integrator::Path ? "path" : "whitted",
+                                 overridden ? " (--integrator)" : ""));
+  };
+  if (used == Integrator::Path) unusedOption("ambient_occlusion", "whitted");
+  if (used == Integrator::Whitted) unusedOption("min_depth", "path");
 }
 
 void buildAmbient(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
