@@ -1,5 +1,6 @@
 #include "glint/readers/yaml_scene_reader.h"
 
+#include <set>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -32,6 +33,10 @@ ValueId findKey(const ValueTree& tree, ValueId map, std::string_view key) {
 // The files being read through `include`, outermost first (to find cycles), and the cancel flag.
 struct IncludeState {
   std::vector<std::filesystem::path> open;  // weakly canonical paths
+  // Files already included (weakly canonical): one reached again — two libraries that both include
+  // a palette — adds nothing a second time (an included file holds only named definitions, and
+  // the same definitions from the same place are not two).
+  std::set<std::filesystem::path> included;
   const std::atomic<bool>* cancel = nullptr;
 };
 
@@ -189,6 +194,7 @@ class TopLevel {
                                        escapeForMessage(identity.filename().string())));
       return;
     }
+    if (includes_.included.contains(identity)) return;
     const std::string name = path.string();
     yaml::Document document;
     try {
@@ -209,12 +215,17 @@ class TopLevel {
       return;
     }
     SourceFile& file = scene_.addFile(name, path.parent_path());
+    includes_.included.insert(identity);
     file.values = std::move(document.values);
     file.bytes = document.bytesRead;
     const auto index = static_cast<std::uint32_t>(scene_.files.size() - 1);
     if (document.secondDocument) {
-      sink_.error(file.location(kNoValue),
-                  "the file holds more than one YAML document; an included file holds exactly one");
+      const TextPosition& second = *document.secondDocument;
+      sink_.error(second.line == 0 ? SourceLocation{name, 1, 1}
+                                   : SourceLocation{name, static_cast<int>(second.line),
+                                                    static_cast<int>(second.column)},
+                  "the file holds more than one YAML document (the second starts here); an "
+                  "included file holds exactly one");
     }
     const ValueId root = document.root;
     if (file.values.isNull(root)) return;  // an empty file includes nothing
@@ -283,7 +294,7 @@ ParseResult describe(SceneDescription scene, yaml::Document* document,
                                             "image, objects, ...), got {}",
                                             reader.describe(root)));
     } else {
-      IncludeState includes{{}, cancel};
+      IncludeState includes{{}, {}, cancel};
       std::error_code ignored;
       includes.open.push_back(std::filesystem::weakly_canonical(file.name, ignored));
       TopLevel(scene, 0, sink, includes).read(root);

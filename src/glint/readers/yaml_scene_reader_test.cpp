@@ -842,6 +842,30 @@ TEST_F(IncludeFiles, IncludedTexturesJoinTheSceneAndAreNamedOnce) {
                                       "twice (first at common/library.yaml:2:3)"}));
 }
 
+TEST_F(IncludeFiles, AFileReachedTwiceIsIncludedOnce) {
+  // Two libraries that both include one palette (a diamond, no cycle), and a name written twice
+  // in one list: the palette's definitions join the scene once, without a "defined twice".
+  write("scene.yaml", std::string("include: [common/walls.yaml, common/floors.yaml, "
+                                  "common/palette.yaml, ./common/palette.yaml]\n") +
+                          kCameraImage +
+                          "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, "
+                          "material: stone}\n");
+  write("common/walls.yaml", "include: palette.yaml\nmaterials:\n  wall: {kd: stone_colour}\n");
+  write("common/floors.yaml", "include: [palette.yaml]\nmaterials:\n  floor: {kd: 0.5}\n");
+  write("common/palette.yaml",
+        "textures:\n  stone_colour: {type: noise}\nmaterials:\n  stone: {kd: [0.5, 0.5, 0.4]}\n");
+  EXPECT_TRUE(errorsOf("scene.yaml").empty());
+  const LoadedScene s = loadScene(dir_ / "scene.yaml");
+  ASSERT_EQ(s.parts.primitives.size(), 1u);
+  EXPECT_EQ(s.parts.materials.at(s.parts.primitives[0].materialIndex()).kd, Color(0.5, 0.5, 0.4));
+  // A name the scene defines as well is still defined twice, once.
+  write("again.yaml", std::string("include: [common/walls.yaml, common/floors.yaml]\n") +
+                          kCameraImage + "materials:\n  stone: {kd: 1}\n");
+  EXPECT_EQ(errorsOf("again.yaml"),
+            (std::vector<std::string>{"again.yaml:5:3: duplicate material 'stone': defined "
+                                      "twice (first at common/palette.yaml:4:3)"}));
+}
+
 TEST_F(IncludeFiles, CyclesMissingFilesAndSceneKeysAreErrorsAtTheirPlace) {
   write("a.yaml", std::string("include: [b.yaml, missing.yaml]\n") + kCameraImage);
   write("b.yaml", "include: [a.yaml]\nmaterials: {m: {kd: 1}}\nobjects: []\n");
@@ -861,6 +885,13 @@ TEST_F(IncludeFiles, CyclesMissingFilesAndSceneKeysAreErrorsAtTheirPlace) {
             "list.yaml:1:1: an included file must be a mapping of materials, got a "
             "list of 1 item");
   EXPECT_THAT(errors[2], HasSubstr("broken.yaml:1:26: syntax error: a '[' is not closed"));
+  // An included file of two documents: the error is at the second one's start, as in a scene.
+  write("d.yaml", std::string("include: two.yaml\n") + kCameraImage);
+  write("two.yaml", "materials:\n  a: {kd: 1}\n---\nmaterials: {}\n");
+  EXPECT_EQ(errorsOf("d.yaml"),
+            (std::vector<std::string>{"two.yaml:3:1: the file holds more than one YAML document "
+                                      "(the second starts here); an included file holds exactly "
+                                      "one"}));
 }
 
 }  // namespace
