@@ -27,7 +27,7 @@ Color Environment::along(const Vec3& d, const Color& uniform) const {
       break;
   }
   // The picture turned by +rotate about +y: look up the direction turned by −rotate.
-  return image->bilinear(0, equirectangularUv(toImage(d))) * intensity;
+  return image->bilinear(0, equirectangularUv(toImage(d)), /*clampRows=*/true) * intensity;
 }
 
 Vec3 Environment::toImage(const Vec3& d) const {

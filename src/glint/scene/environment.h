@@ -26,7 +26,8 @@ struct Environment {
   Color horizon;
   Color nadir;
   // Image: looked up bilinearly at the direction turned by −rotate about +y (so the picture turns
-  // by +rotate degrees, counter-clockwise seen from above), times intensity.
+  // by +rotate degrees, counter-clockwise seen from above), times intensity; around the vertical
+  // it wraps, at the zenith and nadir its top and bottom rows hold (they are not neighbours).
   std::shared_ptr<const MipMap> image;
   double intensity = 1;
   double cosRotate = 1;

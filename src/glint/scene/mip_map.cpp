@@ -88,7 +88,7 @@ Color MipMap::nearest(const Point2& st) const {
                static_cast<int>(std::fmod(y, image.height)));
 }
 
-Color MipMap::bilinear(int level, const Point2& st) const {
+Color MipMap::bilinear(int level, const Point2& st, bool clampRows) const {
   const RgbImage& image = levels_[static_cast<std::size_t>(level)];
   // Texel centres sit at (i + 0.5) / size: shift by half a texel to interpolate between them.
   double x = st.x * image.width - 0.5;
@@ -102,9 +102,14 @@ Color MipMap::bilinear(int level, const Point2& st) const {
   const double fx = x - x0;
   const double fy = y - y0;
   const int ix = static_cast<int>(x0);
-  const int iy = static_cast<int>(y0);
+  int iy = static_cast<int>(y0);
+  int below = iy + 1;
+  if (clampRows) {
+    iy = std::clamp(iy, 0, image.height - 1);
+    below = std::clamp(below, 0, image.height - 1);
+  }
   return lerp(fy, lerp(fx, texel(level, ix, iy), texel(level, ix + 1, iy)),
-              lerp(fx, texel(level, ix, iy + 1), texel(level, ix + 1, iy + 1)));
+              lerp(fx, texel(level, ix, below), texel(level, ix + 1, below)));
 }
 
 double MipMap::levelFor(double width) const {

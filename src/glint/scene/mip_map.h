@@ -42,8 +42,10 @@ class MipMap {
 
   // The texel of level 0 that st falls in.
   Color nearest(const Point2& st) const;
-  // Bilinear interpolation between the four texel centres of `level` around st.
-  Color bilinear(int level, const Point2& st) const;
+  // Bilinear interpolation between the four texel centres of `level` around st. With clampRows,
+  // rows do not wrap (an equirectangular image: its top row is the zenith, its bottom the nadir,
+  // and they do not meet); columns always do.
+  Color bilinear(int level, const Point2& st, bool clampRows = false) const;
   // pbrt-v4's MIPMap::Filter for a trilinear lookup: `width` is the footprint in st units
   // (2 × the largest of |ds/dx|, |dt/dx|, |ds/dy|, |dt/dy|); the fractional level
   // levels() − 1 + log2(width) is blended between its two neighbouring levels (bilinear in each),

@@ -176,6 +176,19 @@ TEST(Environment, ImageAndRotationAndGradient) {
   e.cosRotate = 0;
   e.sinRotate = 1;
   expectColor(e.along({-0.5, r, 0.5}, Color()), 0, 2, 0);
+  // Straight up and down: the top row's and the bottom row's colours alone, the rows not wrapping
+  // into each other at the poles (the top row's mean there: its texels around the pole).
+  e.cosRotate = 1;
+  e.sinRotate = 0;
+  const Color up = e.along({0, 1, 0}, Color());
+  EXPECT_GT(up.r + up.g + up.b, 0);
+  const Color nearUp = e.along({0, 0.99999, -std::sqrt(1 - 0.99999 * 0.99999)}, Color());
+  expectColor(nearUp, 0, 1, 1, 1e-3);  // u = 0.5: halfway between the green and the blue texel
+  expectColor(e.along({0, -1, 0}, Color()), 0, 0, 0);
+  expectColor(e.along({0, -0.99999, -std::sqrt(1 - 0.99999 * 0.99999)}, Color()), 0, 0, 0);
+  // The plain lookup (textures) still repeats vertically: at v = 1 the top and bottom rows blend.
+  expectColor(e.image->bilinear(0, {0.375, 1}), 0, 0.5, 0);
+  expectColor(e.image->bilinear(0, {0.375, 1}, true), 0, 1, 0);
 
   Environment g;
   g.kind = BackgroundKind::Gradient;
