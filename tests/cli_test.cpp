@@ -238,7 +238,7 @@ const std::vector<BrokenScene> kBrokenScenes{
     {"undefined_texture.yaml", "12:67", {"undefined texture 'tyles'", "did you mean 'tiles'"}},
     {"unknown_texture_type.yaml", "10:18", {"chequer", "checker2d"}},
     {"missing_texture_file.yaml", "10:88", {"nowhere.png", "no such file"}},
-    {"unknown_background_type.yaml", "9:21", {"skybox", "gradient or image"}},
+    {"unknown_background_type.yaml", "9:21", {"skybox", "gradient, sky or image"}},
     // Other renderers' formats (DESIGN.md §13), read by their extension.
     {"nff_unknown_statement.nff", "11:1", {"unknown NFF statement 'sp'", "did you mean 's'"}},
     {"nff_not_a_number.nff", "10:7", {"expected a number", "'zero'"}},

@@ -170,6 +170,8 @@ TEST(TextureRender, MirrorSphereAndGlassShowTheEnvironment) {
   writeImage(sky, folder / "sky.exr", Encoding::Linear);
   for (const char* background :
        {"{ type: gradient, zenith: [0, 0, 1], horizon: [1, 1, 1], nadir: [0.3, 0.2, 0] }",
+        "{ type: sky, top: [0, 0, 1], bottom: [1, 0.5, 0], up: [0, 1, 0.3], top_value: 0.7, "
+        "bottom_value: -0.4 }",
         "{ type: image, file: sky.exr, intensity: 2, rotate: 30 }"}) {
     const Scene scene = sceneOf(std::string(R"(
 camera: { position: [0, 0, 4], look_at: [0, 0, 0], fov: 40 }

@@ -349,6 +349,13 @@ TEST(SceneBuilder, ValuesOutOfRangeAtTheValue) {
        "sphere.emission must be >= 0, got [0, -1, 0]"},
       {"objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, emission: -1}\n", 4, 60,
        "sphere.emission must be >= 0, got -1"},
+      {"background: {type: sky, top: [0, 0, 1], bottom: [1, 1, 1], top_value: 1, bottom_value: "
+       "1}\n",
+       3, 71, "background.top_value and background.bottom_value must differ, got 1 and 1"},
+      {"background: {type: sky, top: [0, 0, 1], bottom: [1, 1, 1], along: up}\n", 3, 67,
+       "background.along must be direction or height, got 'up'"},
+      {"background: {type: sky, top: [0, 0, 1], bottom: [1, 1, 1], up: [0, 0, 0]}\n", 3, 64,
+       "background.up must be non-zero"},
       {"materials: {m: {kd: \"#12345\"}}\n", 3, 21,
        "materials.m.kd: expected a color \"#rrggbb\" with 6 hexadecimal digits"},
   };

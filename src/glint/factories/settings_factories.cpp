@@ -223,8 +223,8 @@ void buildAmbient(const SceneDescription& scene, const Entity& e, BuildContext& 
 
 namespace {
 
-// background: {type: gradient, zenith, horizon, nadir} or {type: image, file, intensity, rotate,
-// encoding} (DESIGN.md §9).
+// background: {type: gradient, zenith, horizon, nadir}, {type: sky, top, bottom, up, top_value,
+// bottom_value, along} or {type: image, file, intensity, rotate, encoding} (DESIGN.md §9, §13).
 void buildEnvironment(const ValueReader& reader, const Entity& e, BuildContext& ctx) {
   ParameterDictionary p(reader, e.value, {"in background", "background", "background"});
   p.declareHidden("type");
@@ -241,6 +241,37 @@ void buildEnvironment(const ValueReader& reader, const Entity& e, BuildContext& 
     environment.zenith = zenith.value_or(Color());
     environment.horizon = horizon.value_or(Color());
     environment.nadir = nadir.value_or(environment.horizon);
+  } else if (type && type->value == "sky") {
+    // Tachyon's BACKGROUND_GRADIENT (SKY_SPHERE, or SKY_ORTHO_PLANE as `along: height`).
+    p.declare({"top", "bottom", "up", "top_value", "bottom_value", "along"});
+    environment.kind = BackgroundKind::Sky;
+    const auto top = readColor(p, "top", ctx.encoding);
+    const auto bottom = readColor(p, "bottom", ctx.encoding);
+    if (!p.has("top")) p.requireKey("top");
+    if (!p.has("bottom")) p.requireKey("bottom");
+    environment.skyTop = top.value_or(Color());
+    environment.skyBottom = bottom.value_or(Color());
+    if (const auto up = readDirection(p, "up")) environment.skyUp = *up;
+    const auto topValue = p.number("top_value");
+    const auto bottomValue = p.number("bottom_value");
+    if (topValue) environment.topValue = topValue->value;
+    if (bottomValue) environment.bottomValue = bottomValue->value;
+    if ((topValue || bottomValue) && !(environment.topValue != environment.bottomValue)) {
+      p.error(topValue ? topValue->where : bottomValue->where,
+              fmt::format("background.top_value and background.bottom_value must differ, got {} "
+                          "and {}",
+                          show(environment.topValue), show(environment.bottomValue)));
+    }
+    if (const auto along = p.text("along")) {
+      if (along->value == "height") {
+        environment.skyByHeight = true;
+      } else if (along->value != "direction") {
+        p.error(along->where, fmt::format("background.along must be direction or height, got {}{}",
+                                          quoteForMessage(along->value),
+                                          didYouMean(along->value, std::vector<std::string_view>{
+                                                                       "direction", "height"})));
+      }
+    }
   } else if (type && type->value == "image") {
     p.declare({"file", "intensity", "rotate", "encoding"});
     environment.kind = BackgroundKind::Image;
@@ -264,12 +295,12 @@ void buildEnvironment(const ValueReader& reader, const Entity& e, BuildContext& 
       environment.image = ctx.textures->image(p, file->where, file->value, encoding);
     }
   } else if (type) {
-    p.error(
-        type->where,
-        fmt::format("unknown background type {}; expected gradient or image (or give a colour "
-                    "instead of a mapping){}",
-                    quoteForMessage(type->value),
-                    didYouMean(type->value, std::vector<std::string_view>{"gradient", "image"})));
+    p.error(type->where,
+            fmt::format("unknown background type {}; expected gradient, sky or image (or give a "
+                        "colour instead of a mapping){}",
+                        quoteForMessage(type->value),
+                        didYouMean(type->value,
+                                   std::vector<std::string_view>{"gradient", "sky", "image"})));
     p.markUsed(p.keys());
   }
   p.finish();

@@ -24,18 +24,17 @@ namespace {
 
 using namespace tachyon;
 
-const std::vector<std::string_view> kSupported = {"CAMERA",      "LIGHT",       "DIRECTIONAL_LIGHT",
-                                                  "SPOTLIGHT",   "BACKGROUND",  "FOG",
-                                                  "SHADER_MODE", "SPHERE",      "FCYLINDER",
-                                                  "CYLINDER",    "RING",        "PLANE",
-                                                  "BOX",         "TRI",         "STRI",
-                                                  "VCSTRI",      "VERTEXARRAY", "TEXDEF",
-                                                  "TEXALIAS",    "END_SCENE"};
+const std::vector<std::string_view> kSupported = {"CAMERA",    "LIGHT",       "DIRECTIONAL_LIGHT",
+                                                  "SPOTLIGHT", "BACKGROUND",  "BACKGROUND_GRADIENT",
+                                                  "FOG",       "SHADER_MODE", "SPHERE",
+                                                  "FCYLINDER", "CYLINDER",    "RING",
+                                                  "PLANE",     "BOX",         "TRI",
+                                                  "STRI",      "VCSTRI",      "VERTEXARRAY",
+                                                  "TEXDEF",    "TEXALIAS",    "END_SCENE"};
 // Tachyon statements glint does not read (yet), reported by name rather than as unknown words.
 const std::vector<std::string_view> kUnsupported = {
-    "BACKGROUND_GRADIENT", "SPHEREARRAY",  "POLYCYLINDER", "SCALARVOL", "IMAGEDEF",
-    "SKY_LIGHT",           "SCAPE",        "TPOLYFILE",    "MGFFILE",   "INCLUDE",
-    "START_CLIPGROUP",     "END_CLIPGROUP"};
+    "SPHEREARRAY", "POLYCYLINDER", "SCALARVOL", "IMAGEDEF",        "SKY_LIGHT",    "SCAPE",
+    "TPOLYFILE",   "MGFFILE",      "INCLUDE",   "START_CLIPGROUP", "END_CLIPGROUP"};
 
 constexpr std::size_t kStatementsPerPoll = 1024;
 
@@ -122,6 +121,8 @@ class TachyonReader {
     } else if (word == "BACKGROUND") {
       background_ = in_.color(t, "background");
       backgroundAt_ = t.at;
+    } else if (word == "BACKGROUND_GRADIENT") {
+      backgroundGradient(t);
     } else if (word == "FOG") {
       fog(t);
     } else if (word == "SHADER_MODE") {
@@ -256,6 +257,36 @@ class TachyonReader {
         throw SyntaxError{};
       }
     }
+  }
+
+  // BACKGROUND_GRADIENT SKY_SPHERE|SKY_ORTHO_PLANE UPDIR x y z TOPVAL t BOTTOMVAL b TOPCOLOR r g b
+  // BOTTOMCOLOR r g b: glint's sky background. Tachyon blends by d·UPDIR (SKY_SPHERE, d the ray's
+  // unit direction) or o·UPDIR (SKY_ORTHO_PLANE, o its origin) with UPDIR as written, not made
+  // unit; glint's `up` is a unit vector, so the values are divided by UPDIR's length instead (the
+  // same blend). It replaces BACKGROUND's colour wherever it is written.
+  void backgroundGradient(const Token& t) {
+    const Token kind = in_.need(t, "SKY_SPHERE or SKY_ORTHO_PLANE");
+    const std::string k = upper(kind.text);
+    if (k != "SKY_SPHERE" && k != "SKY_ORTHO_PLANE") {
+      out_.error(kind.at, fmt::format("{}: expected SKY_SPHERE or SKY_ORTHO_PLANE, got {}", t.text,
+                                      quoteForMessage(kind.text)));
+      throw SyntaxError{};
+    }
+    Gradient g;
+    g.at = t.at;
+    g.kindAt = kind.at;
+    g.byHeight = k == "SKY_ORTHO_PLANE";
+    in_.keyword(t, "UPDIR");
+    g.up = in_.point(t, "gradient up direction");
+    in_.keyword(t, "TOPVAL");
+    g.top = in_.number(t, "top value");
+    in_.keyword(t, "BOTTOMVAL");
+    g.bottom = in_.number(t, "bottom value");
+    in_.keyword(t, "TOPCOLOR");
+    g.topColor = in_.color(t, "top color");
+    in_.keyword(t, "BOTTOMCOLOR");
+    g.bottomColor = in_.color(t, "bottom color");
+    gradient_ = g;
   }
 
   void fog(const Token& t) {
@@ -412,7 +443,22 @@ class TachyonReader {
     out_.close();
     out_.addEntity(EntityKind::AmbientEntity, map);
 
-    if (background_) {
+    if (gradient_) {
+      const Gradient& g = *gradient_;
+      map = out_.nextId();
+      out_.openMap(g.at);
+      out_.entry("type", "sky", g.at);
+      if (g.byHeight) out_.entry("along", "height", g.kindAt);
+      in_.emit("up", g.up);
+      const double length = ::glint::length(g.up.vector());
+      const double scale = length > 0 ? 1 / length : 1;  // a zero UPDIR is the factory's error
+      out_.entry("top_value", numberText(g.top.value * scale), g.top.at);
+      out_.entry("bottom_value", numberText(g.bottom.value * scale), g.bottom.at);
+      in_.emit("top", g.topColor);
+      in_.emit("bottom", g.bottomColor);
+      out_.close();
+      out_.addEntity(EntityKind::BackgroundEntity, map);
+    } else if (background_) {
       map = out_.nextId();
       out_.openList(backgroundAt_);
       for (const Number& n : background_->n) out_.scalar(n.text, n.at);
@@ -447,6 +493,14 @@ class TachyonReader {
   std::optional<Camera> camera_;
   std::optional<Triple> background_;
   TextPosition backgroundAt_;
+  struct Gradient {
+    TextPosition at, kindAt;
+    bool byHeight = false;
+    Triple up;
+    Number top, bottom;
+    Triple topColor, bottomColor;
+  };
+  std::optional<Gradient> gradient_;
   struct Fog {
     TextPosition at, modeAt;
     std::string mode;

@@ -11,6 +11,7 @@
 #include <variant>
 
 #include "glint/factories/scene_loader.h"
+#include "glint/scene/environment.h"
 #include "glint/scene/texture.h"
 
 namespace glint {
@@ -199,6 +200,41 @@ TEST(TachyonReader, Texfunc1IsTachyonsCheckerExactly) {
   EXPECT_DOUBLE_EQ(rings->scale, 0.6);  // Tachyon's rings, 60 scale units apart
 }
 
+// BACKGROUND_GRADIENT as Tachyon blends it (measured with Tachyon 0.99: a column of pixels of an
+// empty scene is bottom + (top − bottom) · clamp((t − BOTTOMVAL) / (TOPVAL − BOTTOMVAL), 0, 1) to
+// within a unit of 255, with t = d·UPDIR for SKY_SPHERE — UPDIR as written, not made unit — and
+// o·UPDIR for SKY_ORTHO_PLANE, o the ray's origin); the colour of BACKGROUND is then unused.
+TEST(TachyonReader, BackgroundGradientIsTachyonsSky) {
+  const auto skyOf = [](const std::string& gradient) {
+    const ParseResult r = parseTachyon(
+        "BEGIN_SCENE RESOLUTION 8 8\nBACKGROUND 0.2 0.2 0.2\n" + gradient + "\nEND_SCENE\n",
+        "sky.dat");
+    EXPECT_FALSE(r.hasErrors()) << firstError(r);
+    return buildDescribedScene(r).parts.environment;
+  };
+  const Environment sphere = skyOf(
+      "Background_Gradient Sky_Sphere UpDir 0 2 0 TopVal 1 BottomVal -1 TopColor 0 0 1 "
+      "BottomColor 1 1 1");
+  ASSERT_EQ(sphere.kind, BackgroundKind::Sky);
+  EXPECT_FALSE(sphere.skyByHeight);
+  // Tachyon: t = d·(0, 2, 0) = 2·d.y, blended over −1 .. 1: a quarter of the way up at d.y = −0.25.
+  const double s = std::sqrt(1 - 0.25 * 0.25);
+  const Color quarter = sphere.along({0, -0.25, s}, Color());
+  EXPECT_NEAR(quarter.r, 0.75, 1e-12);
+  EXPECT_NEAR(quarter.b, 1, 1e-12);
+  EXPECT_EQ(sphere.along({0, 0.6, 0.8}, Color()), Color(0, 0, 1));  // 2·0.6 > 1: the top
+  // SKY_ORTHO_PLANE, UPDIR along Tachyon's +x (glint's −x: the scene is mirrored in x): by the
+  // origin's Tachyon x, here 0.5 of the range −1 .. 3 (o·UPDIR = 1 at Tachyon x = 1).
+  const Environment plane = skyOf(
+      "Background_Gradient Sky_Ortho_Plane UpDir 1 0 0 TopVal 3 BottomVal -1 TopColor 1 0 0 "
+      "BottomColor 0 1 0");
+  ASSERT_EQ(plane.kind, BackgroundKind::Sky);
+  EXPECT_TRUE(plane.skyByHeight);
+  const Color atOne = plane.along({0, 0, 1}, Color(), {-1, 5, 5});
+  EXPECT_NEAR(atOne.r, 0.5, 1e-12);
+  EXPECT_NEAR(atOne.g, 0.5, 1e-12);
+}
+
 TEST(TachyonReader, UnsupportedStatementsNameTheNearestSupportedOne) {
   const auto error = [](const std::string& body) {
     return firstError(
@@ -207,9 +243,12 @@ TEST(TachyonReader, UnsupportedStatementsNameTheNearestSupportedOne) {
   EXPECT_EQ(error("SPHEREARRAY NUMSPHERES 1"),
             "bad.dat:2:1: the Tachyon statement SPHEREARRAY is not supported by glint (the "
             "nearest supported statement is SPHERE)");
-  EXPECT_EQ(error("Background_Gradient Sky_Sphere"),
-            "bad.dat:2:1: the Tachyon statement Background_Gradient is not supported by glint (the "
-            "nearest supported statement is BACKGROUND)");
+  EXPECT_EQ(error("Background_Gradient Sky_Plane UpDir 0 1 0"),
+            "bad.dat:2:21: Background_Gradient: expected SKY_SPHERE or SKY_ORTHO_PLANE, got "
+            "'Sky_Plane'");
+  EXPECT_EQ(error("Background_Gradient Sky_Sphere UpDir 0 1 0 TopVal 1 BottomVal -1 TopColor 0 0 "
+                  "1 BottomColr 1 1 1"),
+            "bad.dat:2:81: Background_Gradient: expected BOTTOMCOLOR, got 'BottomColr'");
   EXPECT_EQ(error("SPHER CENTER 0 0 0 RAD 1 x"),
             "bad.dat:2:1: unknown Tachyon statement 'SPHER' (the nearest supported statement is "
             "SPHERE)");

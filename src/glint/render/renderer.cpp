@@ -607,8 +607,7 @@ Color traceFound(const TraceContext& ctx, const Ray& ray, const MediumStack& her
     if (ctx.fog && ctx.scene.fog()->distance == FogDistance::Ray) {
       return ctx.scene.fog()->color;
     }
-    return ctx.uniformBackground ? ctx.scene.background()
-                                 : ctx.scene.backgroundAlong(ray.direction);
+    return ctx.uniformBackground ? ctx.scene.background() : ctx.scene.backgroundSeenBy(ray);
   }
   Color color;
   if (ctx.textured) {
@@ -873,7 +872,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
             brdfPdf > 0 && ctx.environment != nullptr
                 ? brdfSampleWeight(ctx, brdfPdf, ctx.environment->pdf(ray.direction))
                 : 1;
-        radiance += throughput * scene.backgroundAlong(ray.direction) * misWeight;
+        radiance += throughput * scene.backgroundSeenBy(ray) * misWeight;
       }
       break;
     }

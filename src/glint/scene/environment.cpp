@@ -13,10 +13,15 @@ Point2 equirectangularUv(const Vec3& d) {
           1 - std::acos(std::clamp(d.y, -1.0, 1.0)) / std::numbers::pi};
 }
 
-Color Environment::along(const Vec3& d, const Color& uniform) const {
+Color Environment::along(const Vec3& d, const Color& uniform, const Point3& origin) const {
   switch (kind) {
     case BackgroundKind::Uniform:
       return uniform;
+    case BackgroundKind::Sky: {
+      const double t = skyByHeight ? dot(toVec(origin), skyUp) : dot(d, skyUp);
+      const double f = std::clamp((t - bottomValue) / (topValue - bottomValue), 0.0, 1.0);
+      return skyBottom + (skyTop - skyBottom) * f;
+    }
     case BackgroundKind::Gradient: {
       const double elevation =
           std::asin(std::clamp(d.y, -1.0, 1.0)) / (std::numbers::pi / 2);  // −1 .. 1

@@ -12,7 +12,7 @@
 
 namespace glint {
 
-enum class BackgroundKind : std::uint8_t { Uniform, Gradient, Image };
+enum class BackgroundKind : std::uint8_t { Uniform, Gradient, Image, Sky };
 
 // (u, v) of a unit direction d on an equirectangular image (+y up): u = 0.5 + atan2(d.x,
 // −d.z)/(2π), v = 1 − acos(d.y)/π. The image's centre column is −z, its top row +y, +x at u = 0.75.
@@ -32,9 +32,20 @@ struct Environment {
   double intensity = 1;
   double cosRotate = 1;
   double sinRotate = 0;
+  // Sky (Tachyon's BACKGROUND_GRADIENT): skyBottom + (skyTop − skyBottom) · clamp((t − bottomValue)
+  // / (topValue − bottomValue), 0, 1), with t = d·skyUp (skyUp a unit vector; Tachyon's SKY_SPHERE)
+  // or, skyByHeight, t = o·skyUp for the ray's origin o (its SKY_ORTHO_PLANE, for orthographic
+  // views: the gradient runs across the picture, not around the sky).
+  Vec3 skyUp{0, 1, 0};
+  Color skyTop;
+  Color skyBottom;
+  double topValue = 1;
+  double bottomValue = -1;
+  bool skyByHeight = false;
 
-  // The radiance along the unit world direction d (Uniform: `uniform`, the scene's background).
-  Color along(const Vec3& d, const Color& uniform) const;
+  // The radiance along the unit world direction d of a ray from `origin` (Uniform: `uniform`, the
+  // scene's background; only a Sky by height looks at the origin).
+  Color along(const Vec3& d, const Color& uniform, const Point3& origin = Point3()) const;
   // The direction turned by −rotate about +y (where the image is looked up), and back.
   Vec3 toImage(const Vec3& d) const;
   Vec3 fromImage(const Vec3& d) const;

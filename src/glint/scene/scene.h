@@ -177,8 +177,12 @@ class Scene {
   };
   const std::vector<LightSurface>& lightSurfaces() const { return lightSurfaces_; }
   bool uniformBackground() const { return environment_.kind == BackgroundKind::Uniform; }
-  // What a ray leaving the scene along the unit direction d sees.
+  // What a ray leaving the scene along the unit direction d sees (from anywhere: an environment
+  // light's direction), and what the ray itself sees (a sky by height looks at its origin).
   Color backgroundAlong(const Vec3& d) const { return environment_.along(d, background_); }
+  Color backgroundSeenBy(const Ray& ray) const {
+    return environment_.along(ray.direction, background_, ray.origin);
+  }
   const std::optional<Fog>& fog() const { return fog_; }
   const Camera& camera() const { return camera_; }
   const ImageSettings& image() const { return image_; }

@@ -201,6 +201,25 @@ TEST(Environment, ImageAndRotationAndGradient) {
   expectColor(g.along({r, r, 0}, Color()), 0.5, 0.5, 1);  // 45°: halfway in elevation
   Environment uniform;
   expectColor(uniform.along({0, 1, 0}, Color(0.3)), 0.3, 0.3, 0.3);
+
+  // Tachyon's sky: bottom + (top − bottom) · clamp((t − bottom value) / (top − bottom value), 0, 1)
+  // with t = d·up, or o·up for the ray's origin o (by height).
+  Environment sky;
+  sky.kind = BackgroundKind::Sky;
+  sky.skyUp = Vec3(0, 0, 1);
+  sky.skyTop = Color(0, 0, 1);
+  sky.skyBottom = Color(1, 1, 0);
+  sky.topValue = 0.5;
+  sky.bottomValue = -0.5;
+  expectColor(sky.along({0, 0, 1}, Color()), 0, 0, 1);        // past the top value: the top colour
+  expectColor(sky.along({0, 0, -1}, Color()), 1, 1, 0);       // below the bottom one: the bottom
+  expectColor(sky.along({1, 0, 0}, Color()), 0.5, 0.5, 0.5);  // t = 0: halfway
+  expectColor(sky.along({0, 0.8, 0.25 * 0.8 / 0.2 * 0.2}, Color()), 0.3, 0.3, 0.7);  // t = 0.2
+  // By height the direction does not matter, the origin does.
+  sky.skyByHeight = true;
+  expectColor(sky.along({0, 0, 1}, Color(), {3, -2, 0.25}), 0.25, 0.25, 0.75);
+  expectColor(sky.along({0, 1, 0}, Color(), {3, -2, 0.25}), 0.25, 0.25, 0.75);
+  expectColor(sky.along({0, 1, 0}, Color(), {0, 0, -7}), 1, 1, 0);
 }
 
 }  // namespace
