@@ -23,9 +23,9 @@ fs::path outputFor(const ConvertSpec& spec) {
 void checkOutput(const fs::path& output, const fs::path& scene) {
   const std::string extension = output.extension().string();
   if (extension != ".yaml" && extension != ".yml" && extension != ".json") {
-    throw JobError(
-        JobFailure::BadInput,
-        fmt::format("{}: the converted scene is YAML; name it .yaml (or .yml)", output.string()));
+    throw JobError(JobFailure::BadInput,
+                   fmt::format("{}: the converted scene is YAML; name it .yaml (or .yml, .json)",
+                               output.string()));
   }
   fs::path folder = output.parent_path();
   if (folder.empty()) folder = ".";
