@@ -356,6 +356,8 @@ TEST(SceneBuilder, ValuesOutOfRangeAtTheValue) {
        "background.along must be direction or height, got 'up'"},
       {"background: {type: sky, top: [0, 0, 1], bottom: [1, 1, 1], up: [0, 0, 0]}\n", 3, 64,
        "background.up must be non-zero"},
+      {"background: {type: sky, top: [0, 0, 1], bottom: [1, 1, 1], bottom_value: .nan}\n", 3, 74,
+       "background.bottom_value must be a finite number, got .nan"},
       {"materials: {m: {kd: \"#12345\"}}\n", 3, 21,
        "materials.m.kd: expected a color \"#rrggbb\" with 6 hexadecimal digits"},
   };
