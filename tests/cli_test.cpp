@@ -255,6 +255,8 @@ const std::vector<BrokenScene> kBrokenScenes{
     // Counts larger than the file: an error where the numbers run out, not gigabytes reserved.
     {"dat_vertex_count_beyond_file.dat", "4:1", {"expected a number (vertex)", "END_SCENE"}},
     {"dat_triangle_count_beyond_file.dat", "6:1", {"expected a number (vertex index)"}},
+    // A bare mesh file (a quick look): a vertex index past the file's vertices, at its place.
+    {"obj_vertex_index_past.obj", "4:7", {"vertex index 7 is past the file's 3 vertices"}},
 };
 
 TEST_F(Cli, BrokenScenesExitTwoNamingFileLineAndColumn) {

@@ -56,6 +56,12 @@ ParseResult describeQuickLook(const std::filesystem::path& file, const LoadOptio
   try {
     mesh = readMeshFile(file, MeshReadOptions{.sceneFolder = base, .cancel = options.cancel});
   } catch (const MeshLoadError& e) {
+    // At the line and column in the file when the reason names them.
+    if (const std::optional<MeshErrorPlace> place = meshErrorPlace(e.what())) {
+      throw SceneError({{Diagnostic::Severity::Error,
+                         {name, place->line, place->column},
+                         fmt::format("cannot load mesh file: {}", place->reason)}});
+    }
     throw SceneError({{Diagnostic::Severity::Error,
                        {name, 0, 0},
                        fmt::format("cannot load mesh file: {}", e.what())}});

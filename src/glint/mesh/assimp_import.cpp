@@ -461,6 +461,7 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
 
 std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
                                         const ReferencedFileRule& rule) {
+  ObjIndexError indexError;
   try {
     // The bytes, opened as assimp's importers open the file (MeshFileAccess) and mapped rather
     // than copied: reading them into fresh memory costs a page fault per 4 KiB, mapping them
@@ -478,12 +479,21 @@ std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
       void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd, 0);
       if (mapped == MAP_FAILED) return std::nullopt;
       try {
-        obj = parseSimpleObj(std::string_view(static_cast<const char*>(mapped), size));
+        obj = parseSimpleObj(std::string_view(static_cast<const char*>(mapped), size),
+                             &indexError);
       } catch (...) {
         ::munmap(mapped, size);
         throw;
       }
       ::munmap(mapped, size);
+    }
+    if (!obj && indexError.line > 0) {
+      // A vertex index past the file's vertices, which assimp refuses too: said with its place
+      // (in the reason's words, as meshErrorPlace reads them).
+      throw MeshLoadError(fmt::format("invalid file: line {}, column {}: vertex index {} is past "
+                                      "the file's {} vertices",
+                                      indexError.line, indexError.column, indexError.index,
+                                      indexError.vertices));
     }
     if (!obj) return std::nullopt;
     const bool triangles = std::all_of(obj->faceSizes.begin(), obj->faceSizes.end(),
@@ -514,8 +524,9 @@ std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
     part.materialIndex = 0;
     result.parts.push_back(std::move(part));
     return result;
-  } catch (const MeshLoadError&) {
-    // An error: assimp's importer says it in its own words.
+  } catch (const MeshLoadError& e) {
+    if (indexError.line > 0) throw;
+    // Otherwise an error: assimp's importer says it in its own words.
   } catch (const std::bad_alloc&) {
   }
   return std::nullopt;

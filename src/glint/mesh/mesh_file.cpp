@@ -1,7 +1,9 @@
 #include "glint/mesh/mesh_file.h"
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "glint/core/cancel.h"
@@ -15,6 +17,22 @@ std::size_t MeshFile::triangleCount() const {
   std::size_t n = 0;
   for (const TriangleMesh& part : parts) n += part.triangleCount();
   return n;
+}
+
+std::optional<MeshErrorPlace> meshErrorPlace(const std::string& reason) {
+  constexpr std::string_view kPrefix = "invalid file: line ";
+  if (reason.compare(0, kPrefix.size(), kPrefix) != 0) return std::nullopt;
+  int line = 0;
+  int column = 0;
+  int consumed = 0;
+  if (std::sscanf(reason.c_str() + kPrefix.size(), "%9d, column %9d: %n", &line, &column,
+                  &consumed) != 2 ||
+      consumed == 0 || line < 1 || column < 1) {
+    return std::nullopt;
+  }
+  return MeshErrorPlace{line, column,
+                        "invalid file: " + reason.substr(kPrefix.size() +
+                                                         static_cast<std::size_t>(consumed))};
 }
 
 double meshCopyBytes(double triangles, double vertices) {

@@ -54,6 +54,16 @@ class MeshLoadError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A reason that names its place in the mesh file ("invalid file: line 4, column 7: vertex index 9
+// is past the file's 3 vertices", as the OBJ reader words it; the reason travels as text from the
+// mesh reader): that line and column, and the reason without them ("invalid file: vertex ...").
+struct MeshErrorPlace {
+  int line = 0;
+  int column = 0;
+  std::string reason;
+};
+std::optional<MeshErrorPlace> meshErrorPlace(const std::string& reason);
+
 // A material of a mesh file mapped onto glint's (Phong/Whitted) coefficients:
 //   diffuse colour → kd, and ka = kd so the ambient light shows the colour as glint's scenes do
 //   (files' own ambient colours are mostly exporter defaults: 0, 0.2 or 1);

@@ -303,7 +303,6 @@ TEST(ObjFastParse, FilesOutsideTheSubsetAreLeftToAssimp) {
   // assimp's own reading of each (or its refusal) is what glint gives: the fast path declines.
   const std::pair<const char*, std::string> files[] = {
       {"index_zero", triangle + "f 0 1 2\n"},
-      {"index_past_the_end", triangle + "f 1 2 4\n"},
       {"normal_index_past_the_end", triangle + "vn 0 0 1\nf 1//1 2//1 3//2\n"},
       {"relative_indices", triangle + "f -3 -2 -1\n"},
       {"leading_zero_index", triangle + "f 01 2 3\n"},
@@ -331,6 +330,59 @@ TEST(ObjFastParse, FilesOutsideTheSubsetAreLeftToAssimp) {
   for (const auto& [name, text] : files) {
     EXPECT_FALSE(readsTheSame(dir.write(std::string(name) + ".obj", text))) << name;
   }
+}
+
+// A vertex index past the file's vertices: assimp refuses the file ("vertex index out of range"),
+// and glint says where (DESIGN.md §13: errors name the line and column).
+TEST(ObjFastParse, AVertexIndexPastTheFileIsRefusedWithItsPlace) {
+  TempDir dir;
+  const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  struct Case {
+    const char* name;
+    std::string text;
+    std::size_t line, column;
+    std::uint64_t index;
+  };
+  const Case cases[] = {
+      {"past", triangle + "f 1 2 4\n", 4, 7, 4},
+      {"second_face", triangle + "f 1 2 3\nf 3  2\t17\n", 5, 8, 17},
+      {"crlf", "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\nf 1 2 3 5\r\n", 5, 9, 5},
+      {"normals", triangle + "vn 0 0 1\nf 1//1 2//1 3//1\nf 2//1 12//1 3//1\n", 6, 8, 12},
+      {"no_final_newline", triangle + "f 1 2 3\nf 4 2 3", 5, 3, 4},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    ObjIndexError error;
+    EXPECT_FALSE(parseSimpleObj(c.text, &error));
+    EXPECT_EQ(error.line, c.line);
+    EXPECT_EQ(error.column, c.column);
+    EXPECT_EQ(error.index, c.index);
+    EXPECT_EQ(error.vertices, 3u);
+    const fs::path path = dir.write(std::string(c.name) + ".obj", c.text);
+    const ReferencedFileRule rule(path, path.parent_path());
+    EXPECT_THROW(importMeshWithAssimp(path, ".obj", rule), MeshLoadError);  // assimp refuses too
+    const std::string expected = "invalid file: line " + std::to_string(c.line) + ", column " +
+                                 std::to_string(c.column) + ": vertex index " +
+                                 std::to_string(c.index) + " is past the file's 3 vertices";
+    try {
+      importSimpleObj(path, rule);
+      ADD_FAILURE() << "not refused";
+    } catch (const MeshLoadError& e) {
+      EXPECT_EQ(std::string(e.what()), expected);
+    }
+    // Through the reader, and as the quick look places it.
+    const ChildAnswer answer = readInChild(path, nullptr);
+    EXPECT_EQ(answer.refusal, expected);
+    const std::optional<MeshErrorPlace> place = meshErrorPlace(answer.refusal);
+    ASSERT_TRUE(place.has_value());
+    EXPECT_EQ(place->line, static_cast<int>(c.line));
+    EXPECT_EQ(place->column, static_cast<int>(c.column));
+    EXPECT_EQ(place->reason, "invalid file: vertex index " + std::to_string(c.index) +
+                                 " is past the file's 3 vertices");
+  }
+  EXPECT_FALSE(meshErrorPlace("invalid file: OBJ: vertex index out of range"));
+  EXPECT_FALSE(meshErrorPlace("invalid file: line x, column 2: y"));
+  EXPECT_FALSE(meshErrorPlace("no such file"));
 }
 
 TEST(ObjFastParse, ParsesNumbersWithAssimpsRoutine) {
