@@ -479,8 +479,7 @@ std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
       void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd, 0);
       if (mapped == MAP_FAILED) return std::nullopt;
       try {
-        obj = parseSimpleObj(std::string_view(static_cast<const char*>(mapped), size),
-                             &indexError);
+        obj = parseSimpleObj(std::string_view(static_cast<const char*>(mapped), size), &indexError);
       } catch (...) {
         ::munmap(mapped, size);
         throw;
@@ -490,10 +489,10 @@ std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
     if (!obj && indexError.line > 0) {
       // A vertex index past the file's vertices, which assimp refuses too: said with its place
       // (in the reason's words, as meshErrorPlace reads them).
-      throw MeshLoadError(fmt::format("invalid file: line {}, column {}: vertex index {} is past "
-                                      "the file's {} vertices",
-                                      indexError.line, indexError.column, indexError.index,
-                                      indexError.vertices));
+      throw MeshLoadError(
+          fmt::format("invalid file: line {}, column {}: vertex index {} is past "
+                      "the file's {} vertices",
+                      indexError.line, indexError.column, indexError.index, indexError.vertices));
     }
     if (!obj) return std::nullopt;
     const bool triangles = std::all_of(obj->faceSizes.begin(), obj->faceSizes.end(),

@@ -30,9 +30,9 @@ std::optional<MeshErrorPlace> meshErrorPlace(const std::string& reason) {
       consumed == 0 || line < 1 || column < 1) {
     return std::nullopt;
   }
-  return MeshErrorPlace{line, column,
-                        "invalid file: " + reason.substr(kPrefix.size() +
-                                                         static_cast<std::size_t>(consumed))};
+  return MeshErrorPlace{
+      line, column,
+      "invalid file: " + reason.substr(kPrefix.size() + static_cast<std::size_t>(consumed))};
 }
 
 double meshCopyBytes(double triangles, double vertices) {

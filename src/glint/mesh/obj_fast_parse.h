@@ -49,8 +49,7 @@ struct ObjIndexError {
   std::uint64_t index = 0;
   std::size_t vertices = 0;
 };
-std::optional<SimpleObj> parseSimpleObj(std::string_view text,
-                                        ObjIndexError* indexError = nullptr);
+std::optional<SimpleObj> parseSimpleObj(std::string_view text, ObjIndexError* indexError = nullptr);
 
 // Whether the OBJ fast path is turned off: the environment variable GLINT_OBJ_READER set to
 // "assimp" (for benchmarks and the differential tests; any other value or none: the fast path).
