@@ -523,7 +523,7 @@ std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
     part.materialIndex = 0;
     result.parts.push_back(std::move(part));
     return result;
-  } catch (const MeshLoadError& e) {
+  } catch (const MeshLoadError&) {
     if (indexError.line > 0) throw;
     // Otherwise an error: assimp's importer says it in its own words.
   } catch (const std::bad_alloc&) {
