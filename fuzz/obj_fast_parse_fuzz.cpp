@@ -2,8 +2,9 @@
 // (in glint it runs in the import child, where a crash would only refuse the file and so go
 // unseen by mesh_obj_fuzz). What it takes must be consistent (indices within the arrays, faces of
 // 3 or more corners, one corner form); and then, differentially, the mesh glint makes of it must
-// be the one assimp's OBJ importer makes, to the bit, or both must refuse the file (glint naming
-// the place of a vertex index past the file's vertices).
+// be the one assimp's OBJ importer makes, to the bit, or both must refuse the file. The checker of
+// malformed statements (mesh/obj_check.h) runs on every input: it must find nothing in a file the
+// parser takes, and a file glint refuses at a place must be one it finds at fault there.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -13,6 +14,7 @@
 
 #include "glint/core/file_access.h"
 #include "glint/mesh/assimp_import.h"
+#include "glint/mesh/obj_check.h"
 #include "glint/mesh/obj_fast_parse.h"
 #include "mesh_fuzz.h"
 
@@ -48,7 +50,30 @@ void requireSame(const glint::MeshFile& a, const glint::MeshFile& b) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   const std::optional<glint::SimpleObj> obj = glint::parseSimpleObj(text);
-  if (!obj) return 0;
+  const std::optional<glint::ObjFault> fault = glint::findObjFault(text);
+  if (fault) {
+    require(!obj);
+    require(fault->line >= 1 && fault->column >= 1 && !fault->what.empty());
+    std::size_t lines = 1;
+    for (const char c : text) lines += c == '\n' || c == '\r' ? 1 : 0;
+    require(fault->line <= lines);
+  }
+  if (!obj) {
+    if (!fault) return 0;
+    // Refused through the reader's path, at the fault's place.
+    const std::filesystem::path path = glint::fuzz::workFolder() / "input.obj";
+    glint::fuzz::writeFile(path, text);
+    const glint::ReferencedFileRule rule(path, path.parent_path());
+    try {
+      glint::importSimpleObj(path, rule);
+      require(false);
+    } catch (const glint::MeshLoadError& e) {
+      const std::optional<glint::MeshErrorPlace> place = glint::meshErrorPlace(e.what());
+      require(place && place->line == static_cast<int>(fault->line) &&
+              place->column == static_cast<int>(fault->column));
+    }
+    return 0;
+  }
   std::size_t corners = 0;
   for (const std::uint32_t n : obj->faceSizes) {
     require(n >= 3);
@@ -75,12 +100,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::optional<glint::MeshFile> fast;
   try {
     fast = glint::importSimpleObj(path, rule);
-  } catch (const glint::MeshLoadError& e) {
-    // Only a vertex index past the file's vertices, named with its place, and only where assimp
-    // refuses the file too.
-    require(glint::meshErrorPlace(e.what()).has_value());
-    require(!reference.has_value());
-    return 0;
+  } catch (const glint::MeshLoadError&) {
+    // A refusal at a place needs a fault, which a file the parser takes has not.
+    require(false);
   }
   require(fast.has_value() == reference.has_value());
   if (fast) {

@@ -255,8 +255,13 @@ const std::vector<BrokenScene> kBrokenScenes{
     // Counts larger than the file: an error where the numbers run out, not gigabytes reserved.
     {"dat_vertex_count_beyond_file.dat", "4:1", {"expected a number (vertex)", "END_SCENE"}},
     {"dat_triangle_count_beyond_file.dat", "6:1", {"expected a number (vertex index)"}},
-    // A bare mesh file (a quick look): a vertex index past the file's vertices, at its place.
+    // A bare mesh file (a quick look): a malformed statement at its place — a vertex index past the
+    // file's vertices...
     {"obj_vertex_index_past.obj", "4:7", {"vertex index 7 is past the file's 3 vertices"}},
+    // ... a word that is no number (assimp would read it as 1), an index past the normals (assimp
+    // would drop every normal).
+    {"obj_not_a_number.obj", "3:7", {"'1x' is not a number"}},
+    {"obj_normal_index_past.obj", "5:16", {"normal index 2 is past the file's 1 normal"}},
 };
 
 TEST_F(Cli, BrokenScenesExitTwoNamingFileLineAndColumn) {

@@ -33,6 +33,7 @@
 #include "glint/core/file_access.h"
 #include "glint/mesh/import_child.h"
 #include "glint/mesh/mesh_repair.h"
+#include "glint/mesh/obj_check.h"
 #include "glint/mesh/obj_fast_parse.h"
 #include "glint/scene/scene_limits.h"
 
@@ -461,13 +462,14 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
 
 std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
                                         const ReferencedFileRule& rule) {
-  ObjIndexError indexError;
+  bool located = false;
   try {
     // The bytes, opened as assimp's importers open the file (MeshFileAccess) and mapped rather
     // than copied: reading them into fresh memory costs a page fault per 4 KiB, mapping them
     // with MAP_POPULATE one call. (A file cut short while mapped kills this child with SIGBUS:
     // a refused file, as any crash here.)
     std::optional<SimpleObj> obj;
+    std::optional<ObjFault> fault;
     {
       MeshFileAccess files(rule);
       const ReadableFile file = files.openChecked(path.c_str());
@@ -479,20 +481,21 @@ std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
       void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd, 0);
       if (mapped == MAP_FAILED) return std::nullopt;
       try {
-        obj = parseSimpleObj(std::string_view(static_cast<const char*>(mapped), size), &indexError);
+        const std::string_view text(static_cast<const char*>(mapped), size);
+        obj = parseSimpleObj(text);
+        // A file outside the subset: its first malformed statement, if any, said at its place.
+        if (!obj) fault = findObjFault(text);
       } catch (...) {
         ::munmap(mapped, size);
         throw;
       }
       ::munmap(mapped, size);
     }
-    if (!obj && indexError.line > 0) {
-      // A vertex index past the file's vertices, which assimp refuses too: said with its place
-      // (in the reason's words, as meshErrorPlace reads them).
-      throw MeshLoadError(
-          fmt::format("invalid file: line {}, column {}: vertex index {} is past "
-                      "the file's {} vertices",
-                      indexError.line, indexError.column, indexError.index, indexError.vertices));
+    if (fault) {
+      // In the reason's words, as meshErrorPlace reads them.
+      located = true;
+      throw MeshLoadError(fmt::format("invalid file: line {}, column {}: {}", fault->line,
+                                      fault->column, fault->what));
     }
     if (!obj) return std::nullopt;
     const bool triangles = std::all_of(obj->faceSizes.begin(), obj->faceSizes.end(),
@@ -524,7 +527,7 @@ std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
     result.parts.push_back(std::move(part));
     return result;
   } catch (const MeshLoadError&) {
-    if (indexError.line > 0) throw;
+    if (located) throw;
     // Otherwise an error: assimp's importer says it in its own words.
   } catch (const std::bad_alloc&) {
   }

@@ -23,8 +23,10 @@ MeshFile importMesh(const std::filesystem::path& path, const std::string& extens
 // An OBJ file of the plain subset (obj_fast_parse.h) read by glint's parser and then converted as
 // importMeshWithAssimp converts assimp's scene (the same post-processing and repairs): the same
 // MeshFile. Nothing for a file outside the subset or one that fails (the caller then lets assimp
-// read it, and report the failure in its words) — except a face's vertex index past the file's
-// vertices, which assimp refuses too: MeshLoadError naming its line and column (meshErrorPlace).
+// read it, and report the failure in its words) — except a file outside the subset with a
+// malformed statement (findObjFault, obj_check.h: a word that is no number, an index past the
+// file's vertices...): MeshLoadError naming the statement's line and column (meshErrorPlace),
+// whether assimp would refuse the file or repair it.
 std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
                                         const ReferencedFileRule& rule);
 

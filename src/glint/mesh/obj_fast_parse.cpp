@@ -41,8 +41,7 @@ enum class CornerForm : std::uint8_t { Unknown, V, VT, VN, VTN };
 
 class Parser {
  public:
-  explicit Parser(std::string_view text, ObjIndexError* indexError)
-      : text_(text), p_(text.data()), end_(text.data() + text.size()), indexError_(indexError) {}
+  explicit Parser(std::string_view text) : p_(text.data()), end_(text.data() + text.size()) {}
 
   std::optional<SimpleObj> run() {
     reserve();
@@ -283,11 +282,8 @@ class Parser {
       }
       return true;
     };
-    if (!inRange(obj_.vertexIndices, obj_.positions.size() / 3)) {
-      if (indexError_ != nullptr) locateVertexIndexPast(obj_.positions.size() / 3);
-      return std::nullopt;
-    }
-    if (!inRange(obj_.normalIndices, obj_.normals.size() / 3) ||
+    if (!inRange(obj_.vertexIndices, obj_.positions.size() / 3) ||
+        !inRange(obj_.normalIndices, obj_.normals.size() / 3) ||
         !inRange(obj_.texcoordIndices, obj_.texcoords.size() / 3)) {
       return std::nullopt;
     }
@@ -296,41 +292,8 @@ class Parser {
     return std::move(obj_);
   }
 
-  // The first face corner whose vertex index is past `vertices`, into *indexError_: the file has
-  // been read whole, so each `f` line is in the subset (corners start after blanks; a vertex
-  // index is the corner's leading digits).
-  void locateVertexIndexPast(std::size_t vertices) {
-    std::size_t lineNumber = 0;
-    for (std::size_t start = 0; start < text_.size();) {
-      std::size_t end = text_.find('\n', start);
-      if (end == std::string_view::npos) end = text_.size();
-      ++lineNumber;
-      const std::string_view line = text_.substr(start, end - start);
-      if (line.size() > 1 && line[0] == 'f' && blank(line[1])) {
-        for (std::size_t i = 1; i < line.size();) {
-          if (blank(line[i]) || line[i] == '\r') {
-            ++i;
-            continue;
-          }
-          std::uint64_t value = 0;
-          std::size_t j = i;
-          while (j < line.size() && digit(line[j])) value = value * 10 + (line[j++] - '0');
-          if (value > vertices) {
-            *indexError_ = {lineNumber, i + 1, value, vertices};
-            return;
-          }
-          while (j < line.size() && !blank(line[j]) && line[j] != '\r') ++j;
-          i = j;
-        }
-      }
-      start = end + 1;
-    }
-  }
-
-  std::string_view text_;
   const char* p_;
   const char* end_;
-  ObjIndexError* indexError_;
   SimpleObj obj_;
   CornerForm form_ = CornerForm::Unknown;
   bool named_ = false;
@@ -338,10 +301,10 @@ class Parser {
 
 }  // namespace
 
-std::optional<SimpleObj> parseSimpleObj(std::string_view text, ObjIndexError* indexError) {
+std::optional<SimpleObj> parseSimpleObj(std::string_view text) {
   // assimp refuses an OBJ file under 16 bytes; a NUL anywhere ends a line for it.
   if (text.size() < 16) return std::nullopt;
-  return Parser(text, indexError).run();
+  return Parser(text).run();
 }
 
 bool objFastPathDisabled() {

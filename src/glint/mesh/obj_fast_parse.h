@@ -38,18 +38,7 @@ struct SimpleObj {
 // from face to face, a line continuation, a carriage return not before a line feed, a NUL. The
 // numbers are parsed by assimp's own routine (fast_atof.h), so positions, normals and texture
 // coordinates are the same floats to the bit.
-//
-// A file of the subset whose only fault is a face's vertex index past the file's `v` lines is one
-// assimp refuses too ("OBJ: vertex index out of range"): with `indexError`, its first such corner
-// is given there (1-based line and column of the index, the index as written, the vertex count),
-// so that the refusal can say where.
-struct ObjIndexError {
-  std::size_t line = 0;
-  std::size_t column = 0;
-  std::uint64_t index = 0;
-  std::size_t vertices = 0;
-};
-std::optional<SimpleObj> parseSimpleObj(std::string_view text, ObjIndexError* indexError = nullptr);
+std::optional<SimpleObj> parseSimpleObj(std::string_view text);
 
 // Whether the OBJ fast path is turned off: the environment variable GLINT_OBJ_READER set to
 // "assimp" (for benchmarks and the differential tests; any other value or none: the fast path).

@@ -4,7 +4,8 @@
 // is read both ways, and the meshes must be the same to the bit — positions, normals, texture
 // coordinates, colours, triangle order, materials, dropped triangles — or the file must be one the
 // fast path leaves to assimp. Through readMeshFile (the import child) both ways the answer, or the
-// refusal's words, must be identical.
+// refusal's words, must be identical — unless the file has a malformed statement (obj_check.h),
+// which glint refuses at its place.
 #include "glint/mesh/obj_fast_parse.h"
 
 #include <gtest/gtest.h>
@@ -15,6 +16,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -25,6 +28,7 @@
 #include "glint/mesh/assimp_import.h"
 #include "glint/mesh/mesh_file.h"
 #include "glint/mesh/mesh_test_support.h"
+#include "glint/mesh/obj_check.h"
 
 namespace glint::mesh_test {
 namespace {
@@ -108,13 +112,29 @@ ChildAnswer readInChild(const fs::path& path, const char* reader) {
   return answer;
 }
 
+std::string readFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A fault's refusal as the reader words it (meshErrorPlace reads it back).
+std::string locatedReason(const ObjFault& fault) {
+  return "invalid file: line " + std::to_string(fault.line) + ", column " +
+         std::to_string(fault.column) + ": " + fault.what;
+}
+
 // Whether glint's parser took `path` (in this process), after checking that it gives what
 // assimp gives, in this process and through the import child. A file assimp refuses must not be
 // taken.
 bool readsTheSame(const fs::path& path) {
   SCOPED_TRACE(path.string());
   const ReferencedFileRule rule(path, path.parent_path());
-  const std::optional<MeshFile> fast = importSimpleObj(path, rule);
+  std::optional<MeshFile> fast;
+  try {
+    fast = importSimpleObj(path, rule);
+  } catch (const MeshLoadError& e) {
+    EXPECT_TRUE(meshErrorPlace(e.what())) << e.what();  // only a located refusal
+  }
   if (fast) {
     std::optional<MeshFile> reference;
     try {
@@ -126,8 +146,15 @@ bool readsTheSame(const fs::path& path) {
       EXPECT_EQ(difference(*fast, *reference), "");
     }
   }
-  const ChildAnswer viaAssimp = readInChild(path, "assimp");
   const ChildAnswer viaDefault = readInChild(path, nullptr);
+  if (!fast) {
+    if (const std::optional<ObjFault> fault = findObjFault(readFile(path))) {
+      // Refused at the statement's place, whatever assimp makes of the file.
+      EXPECT_EQ(viaDefault.refusal, locatedReason(*fault));
+      return false;
+    }
+  }
+  const ChildAnswer viaAssimp = readInChild(path, "assimp");
   EXPECT_EQ(viaDefault.refusal, viaAssimp.refusal);
   EXPECT_EQ(viaDefault.file.has_value(), viaAssimp.file.has_value());
   if (viaDefault.file && viaAssimp.file) {
@@ -302,8 +329,6 @@ TEST(ObjFastParse, FilesOutsideTheSubsetAreLeftToAssimp) {
   const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   // assimp's own reading of each (or its refusal) is what glint gives: the fast path declines.
   const std::pair<const char*, std::string> files[] = {
-      {"index_zero", triangle + "f 0 1 2\n"},
-      {"normal_index_past_the_end", triangle + "vn 0 0 1\nf 1//1 2//1 3//2\n"},
       {"relative_indices", triangle + "f -3 -2 -1\n"},
       {"leading_zero_index", triangle + "f 01 2 3\n"},
       {"mixed_corner_forms", triangle + "vn 0 0 1\nf 1//1 2//1 3//1\nf 1 2 3\n"},
@@ -325,45 +350,67 @@ TEST(ObjFastParse, FilesOutsideTheSubsetAreLeftToAssimp) {
       {"trailing_comment", "v 0 0 0 # origin\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"},
       {"second_object_name", "o a\no b\n" + triangle + "f 1 2 3\n"},
       {"only_vertices", triangle},
-      {"tiny", "f 1 2 3\n"},
+      {"tiny", "v 0 0 0\n"},
   };
   for (const auto& [name, text] : files) {
+    EXPECT_FALSE(findObjFault(text)) << name;  // none malformed
     EXPECT_FALSE(readsTheSame(dir.write(std::string(name) + ".obj", text))) << name;
   }
 }
 
-// A vertex index past the file's vertices: assimp refuses the file ("vertex index out of range"),
-// and glint says where (DESIGN.md §13: errors name the line and column).
-TEST(ObjFastParse, AVertexIndexPastTheFileIsRefusedWithItsPlace) {
+// A file with a malformed statement is refused with its place (DESIGN.md §7 and §13: errors name
+// the line and column), whether assimp would refuse it in other words ("OBJ: vertex index out of
+// range" for a missing number, "Invalid face index" for an index 0) or repair it silently (read
+// "1x" as 1, drop every normal for one index past them).
+TEST(ObjFastParse, AMalformedStatementIsRefusedWithItsPlace) {
   TempDir dir;
   const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
   struct Case {
     const char* name;
     std::string text;
     std::size_t line, column;
-    std::uint64_t index;
+    std::string what;
   };
   const Case cases[] = {
-      {"past", triangle + "f 1 2 4\n", 4, 7, 4},
-      {"second_face", triangle + "f 1 2 3\nf 3  2\t17\n", 5, 8, 17},
-      {"crlf", "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\nf 1 2 3 5\r\n", 5, 9, 5},
-      {"normals", triangle + "vn 0 0 1\nf 1//1 2//1 3//1\nf 2//1 12//1 3//1\n", 6, 8, 12},
-      {"no_final_newline", triangle + "f 1 2 3\nf 4 2 3", 5, 3, 4},
+      {"past", triangle + "f 1 2 4\n", 4, 7, "vertex index 4 is past the file's 3 vertices"},
+      {"second_face", triangle + "f 1 2 3\nf 3  2\t17\n", 5, 8,
+       "vertex index 17 is past the file's 3 vertices"},
+      {"crlf", "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\nf 1 2 3 5\r\n", 5, 9,
+       "vertex index 5 is past the file's 3 vertices"},
+      {"normals", triangle + "vn 0 0 1\nf 1//1 2//1 3//1\nf 2//1 12//1 3//1\n", 6, 8,
+       "vertex index 12 is past the file's 3 vertices"},
+      {"no_final_newline", triangle + "f 1 2 3\nf 4 2 3", 5, 3,
+       "vertex index 4 is past the file's 3 vertices"},
+      {"tiny", "f 1 2 3\n", 1, 3, "vertex index 1 is past the file's 0 vertices"},
+      {"not_a_number", "v 0 0 0\nv 1 0 x\nv 0 1 0\nf 1 2 3\n", 2, 7, "'x' is not a number"},
+      {"number_and_letter", "v 0 0 0\nv 1 0 1x\nv 0 1 0\nf 1 2 3\n", 2, 7, "'1x' is not a number"},
+      {"decimal_comma", "v 0 0 0\nv 1,5 0 0\nv 0 1 0\nf 1 2 3\n", 2, 3, "'1,5' is not a number"},
+      {"two_numbers", "v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n", 2, 6,
+       "'v' needs 3 numbers, this line has 2"},
+      {"index_zero", triangle + "f 0 1 2\n", 4, 3,
+       "vertex index 0: OBJ indices count from 1 (or back from -1)"},
+      {"relative_too_far", triangle + "f -1 -2 -4\n", 4, 9,
+       "vertex index -4 reaches before the first vertex (3 are above it)"},
+      {"normal_past", triangle + "vn 0 0 1\nf 1//1 2//1 3//2\n", 5, 16,
+       "normal index 2 is past the file's 1 normal"},
+      {"texture_past", triangle + "vt 0 0\nvt 1 0\nf 1/1 2/2 3/3\n", 6, 13,
+       "texture coordinate index 3 is past the file's 2 texture coordinates"},
+      {"corner_letter", triangle + "usemtl red\nf 1 2 x\n", 5, 7,
+       "'x' is not a face corner (v, v/vt, v//vn or v/vt/vn, whole numbers)"},
+      {"after_a_group", triangle + "g part\nf 1 2 3 # done\nf 2 3 9\n", 6, 7,
+       "vertex index 9 is past the file's 3 vertices"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
-    ObjIndexError error;
-    EXPECT_FALSE(parseSimpleObj(c.text, &error));
-    EXPECT_EQ(error.line, c.line);
-    EXPECT_EQ(error.column, c.column);
-    EXPECT_EQ(error.index, c.index);
-    EXPECT_EQ(error.vertices, 3u);
+    const std::optional<ObjFault> fault = findObjFault(c.text);
+    ASSERT_TRUE(fault.has_value());
+    EXPECT_EQ(fault->line, c.line);
+    EXPECT_EQ(fault->column, c.column);
+    EXPECT_EQ(fault->what, c.what);
+    EXPECT_FALSE(parseSimpleObj(c.text));
     const fs::path path = dir.write(std::string(c.name) + ".obj", c.text);
     const ReferencedFileRule rule(path, path.parent_path());
-    EXPECT_THROW(importMeshWithAssimp(path, ".obj", rule), MeshLoadError);  // assimp refuses too
-    const std::string expected = "invalid file: line " + std::to_string(c.line) + ", column " +
-                                 std::to_string(c.column) + ": vertex index " +
-                                 std::to_string(c.index) + " is past the file's 3 vertices";
+    const std::string expected = locatedReason(*fault);
     try {
       importSimpleObj(path, rule);
       ADD_FAILURE() << "not refused";
@@ -377,8 +424,7 @@ TEST(ObjFastParse, AVertexIndexPastTheFileIsRefusedWithItsPlace) {
     ASSERT_TRUE(place.has_value());
     EXPECT_EQ(place->line, static_cast<int>(c.line));
     EXPECT_EQ(place->column, static_cast<int>(c.column));
-    EXPECT_EQ(place->reason, "invalid file: vertex index " + std::to_string(c.index) +
-                                 " is past the file's 3 vertices");
+    EXPECT_EQ(place->reason, "invalid file: " + c.what);
   }
   EXPECT_FALSE(meshErrorPlace("invalid file: OBJ: vertex index out of range"));
   EXPECT_FALSE(meshErrorPlace("invalid file: line x, column 2: y"));
