@@ -411,12 +411,40 @@ TEST_F(Cli, AnExrModuleThatCannotLoadFailsBeforeTheRender) {
   EXPECT_FALSE(fs::exists(work_ / "refused.png"));
 }
 
-TEST_F(Cli, OutputPathThatIsAFolderIsAWriteFailure) {
+// Output paths no image can be written to are wrong arguments (exit 2), refused before the render.
+TEST_F(Cli, OutputPathsThatCannotBeAFileExitTwo) {
   fs::create_directory(work_ / "out.png");
-  const RunResult r = run({"render", small(), "-o", "out.png"});
-  EXPECT_EQ(r.status, 1);
-  EXPECT_TRUE(contains(r.err, "out.png")) << r.err;
+  RunResult r = run({"render", small(), "-o", "out.png"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "cannot write 'out.png': it is a folder")) << r.err;
   EXPECT_TRUE(fs::is_empty(work_ / "out.png"));
+  writeFile(work_ / "file", "precious");
+  r = run({"render", small(), "-o", "file/out.png"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "cannot write 'file/out.png': 'file' is not a folder")) << r.err;
+  const std::string longName = std::string(300, 'a') + ".png";
+  r = run({"render", small(), "-o", longName});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "the file name is 304 bytes long, longer than the 255")) << r.err;
+  EXPECT_FALSE(contains(r.err, "%")) << "it rendered first: " << r.err;
+  EXPECT_EQ(filesIn(work_), (std::set<std::string>{"file", "out.png"}));
+  EXPECT_EQ(readFile(work_ / "file"), "precious");
+}
+
+// An image past the file-size limit (ulimit -f) fails its write (exit 1) rather than being killed
+// by SIGXFSZ, and removes its temporary file.
+TEST_F(Cli, AnImagePastTheFileSizeLimitIsAWriteFailureThatLeavesNoFile) {
+  rlimit previous{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &previous), 0);
+  rlimit limited = previous;
+  limited.rlim_cur = 4096;  // bytes; the 200×150 PPM is 90,015
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
+  const RunResult r = run({"render", small(), "--width", "200", "-o", "out.ppm", "--quiet"});
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &previous), 0);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_TRUE(contains(r.err, "cannot write 'out.ppm'")) << r.err;
+  EXPECT_TRUE(contains(r.err, "File too large")) << r.err;
+  EXPECT_TRUE(filesIn(work_).empty()) << "a temporary file was left behind";
 }
 
 // --- overrides ------------------------------------------------------------------------------

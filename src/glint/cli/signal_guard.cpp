@@ -17,7 +17,9 @@ static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_alw
 
 constexpr std::array<int, 3> kHandledSignals{SIGINT, SIGTERM, SIGHUP};
 std::array<struct sigaction, kHandledSignals.size()> gPrevious{};
-struct sigaction gPreviousPipe {};
+// Ignored while the guard lives: SIGPIPE and SIGXFSZ (their writes fail instead).
+constexpr std::array<int, 2> kIgnoredSignals{SIGPIPE, SIGXFSZ};
+std::array<struct sigaction, kIgnoredSignals.size()> gPreviousIgnored{};
 
 extern "C" void onStopSignal(int signal) {
   int expected = 0;
@@ -51,7 +53,9 @@ SignalGuard::SignalGuard() {
   struct sigaction ignore {};
   ignore.sa_handler = SIG_IGN;
   sigemptyset(&ignore.sa_mask);
-  sigaction(SIGPIPE, &ignore, &gPreviousPipe);
+  for (std::size_t i = 0; i < kIgnoredSignals.size(); ++i) {
+    sigaction(kIgnoredSignals[i], &ignore, &gPreviousIgnored[i]);
+  }
 }
 
 SignalGuard::~SignalGuard() {
@@ -65,7 +69,9 @@ SignalGuard::~SignalGuard() {
   for (std::size_t i = 0; i < kHandledSignals.size(); ++i) {
     sigaction(kHandledSignals[i], &gPrevious[i], nullptr);
   }
-  sigaction(SIGPIPE, &gPreviousPipe, nullptr);
+  for (std::size_t i = 0; i < kIgnoredSignals.size(); ++i) {
+    sigaction(kIgnoredSignals[i], &gPreviousIgnored[i], nullptr);
+  }
 }
 
 const std::atomic<bool>& SignalGuard::cancelFlag() const { return gCancel; }

@@ -10,7 +10,9 @@ namespace glint::cli {
 // unless a stop signal came (the handlers then stay until the process exits).
 // SIGHUP (the terminal or the ssh session closed) stops a render like SIGTERM; SIGPIPE is ignored
 // meanwhile, so that a vanished reader of stderr fails the progress writes instead of killing the
-// process before the checkpoint is saved. Only one may exist at a time: the handlers share
+// process before the checkpoint is saved; so is SIGXFSZ, so that an image past the file-size limit
+// (ulimit -f) fails its write (EFBIG: exit 1, the temporary file removed) instead of killing the
+// process with the temporary file left behind. Only one may exist at a time: the handlers share
 // process-wide state.
 class SignalGuard {
  public:

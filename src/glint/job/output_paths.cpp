@@ -47,10 +47,24 @@ void checkOutputPath(const fs::path& out, const fs::path& scene,
   }
   const fs::path folder = folderOf(out);
   std::error_code error;
-  if (!fs::is_directory(folder, error))
+  if (!fs::is_directory(folder, error)) {
+    const bool exists = fs::exists(folder, error);
+    throw JobError(
+        JobFailure::BadInput,
+        fmt::format("cannot write '{}': {}", out.string(),
+                    exists ? fmt::format("'{}' is not a folder", folder.string())
+                           : fmt::format("the folder '{}' does not exist", folder.string())));
+  }
+  // A name the file system cannot hold would fail only when the finished image is renamed.
+  const long nameMax = ::pathconf(folder.c_str(), _PC_NAME_MAX);
+  if (nameMax > 0 && out.filename().string().size() > static_cast<std::size_t>(nameMax))
     throw JobError(JobFailure::BadInput,
-                   fmt::format("cannot write '{}': the folder '{}' does not exist", out.string(),
-                               folder.string()));
+                   fmt::format("cannot write '{}': the file name is {} bytes long, longer than "
+                               "the {} its folder allows",
+                               out.string(), out.filename().string().size(), nameMax));
+  if (fs::is_directory(out, error))
+    throw JobError(JobFailure::BadInput,
+                   fmt::format("cannot write '{}': it is a folder", out.string()));
   // The image replaces its target only when complete, but it would still replace an input.
   if (!scene.empty() && sameFile(out, scene))
     throw JobError(JobFailure::BadInput,
@@ -59,9 +73,6 @@ void checkOutputPath(const fs::path& out, const fs::path& scene,
     throw JobError(JobFailure::BadInput,
                    fmt::format("the checkpoint '{}' cannot be the output image", resume->string()));
   // Writing problems (exit 1) that can be seen now rather than after the render.
-  if (fs::is_directory(out, error))
-    throw JobError(JobFailure::Failure,
-                   fmt::format("cannot write '{}': it is a folder", out.string()));
   if (access(folder.c_str(), W_OK | X_OK) != 0)
     throw JobError(JobFailure::Failure,
                    fmt::format("cannot write '{}': the folder '{}' is not writable", out.string(),
