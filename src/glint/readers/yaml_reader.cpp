@@ -116,6 +116,17 @@ class Source {
     return current == line ? content : std::string();
   }
 
+  // Up to `count` bytes of the text from byte `offset` (fewer at its end); for a file, read again.
+  std::string bytesAt(std::uint64_t offset, std::size_t count) const {
+    if (inMemory()) {
+      return offset < text_.size() ? std::string(text_.substr(offset, count)) : std::string();
+    }
+    std::string bytes(count, '\0');
+    const ssize_t n = ::pread(fd_, bytes.data(), count, static_cast<off_t>(offset));
+    bytes.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
+    return bytes;
+  }
+
   // Line and column (1-based, in characters) of a byte offset of the text.
   TextPosition positionOfByte(std::uint64_t offset) const {
     TextPosition p{0, 1, 1};
@@ -599,6 +610,58 @@ class Reader {
     doc_.values.attach(target);
   }
 
+  // libyaml's UTF-8 errors placed at the character's first byte and said with its bytes. libyaml
+  // gives the offset of the byte it stopped at — for a bad continuation byte that one (and its
+  // value), for a sequence cut by the end of the file the first byte (and -1) — so the message
+  // named the byte after a Latin-1 'é'.
+  SyntaxError notUtf8(std::uint64_t offset, const std::string& problem) const {
+    if (problem == "invalid trailing UTF-8 octet") {
+      // Back to the sequence's first byte (at most 3 before: a sequence is at most 4 bytes).
+      const std::uint64_t from = offset >= 3 ? offset - 3 : 0;
+      const std::string before = source_.bytesAt(from, static_cast<std::size_t>(offset - from));
+      for (std::size_t i = before.size(); i-- > 0;) {
+        if ((static_cast<unsigned char>(before[i]) & 0xC0) == 0xC0) {
+          offset = from + i;
+          break;
+        }
+      }
+    }
+    const std::string bytes = source_.bytesAt(offset, 4);
+    const auto byte = [&](std::size_t i) {
+      return fmt::format("0x{:02X}", static_cast<unsigned char>(bytes[i]));
+    };
+    std::string message;
+    if (bytes.empty()) {
+      message = "the file is not UTF-8 text here (" + problem + ")";
+    } else if (problem == "invalid leading UTF-8 octet") {
+      message =
+          fmt::format("the file is not UTF-8 text here: byte {} cannot start a character", byte(0));
+    } else if (problem == "invalid trailing UTF-8 octet" ||
+               problem == "incomplete UTF-8 octet sequence") {
+      message = fmt::format(
+          "the file is not UTF-8 text here: byte {} starts a character the bytes after it do not "
+          "complete",
+          byte(0));
+    } else {
+      // An overlong form or no Unicode character (a surrogate, past U+10FFFF): the whole sequence.
+      const auto lead = static_cast<unsigned char>(bytes[0]);
+      const std::size_t width = lead >= 0xF0 ? 4 : lead >= 0xE0 ? 3 : 2;
+      std::string shown;
+      for (std::size_t i = 0; i < width && i < bytes.size(); ++i) {
+        shown += (i > 0 ? " " : "") + byte(i);
+      }
+      message = fmt::format("the file is not UTF-8 text here: bytes {} are {}", shown,
+                            problem == "invalid Unicode character"
+                                ? "no Unicode character (a surrogate or past U+10FFFF)"
+                                : "a character in more bytes than UTF-8 allows");
+    }
+    if (!bytes.empty() && problem != "invalid Unicode character" &&
+        problem != "invalid length of a UTF-8 sequence") {
+      message += " (a Latin-1 or Windows-1252 file? save it as UTF-8)";
+    }
+    return SyntaxError(source_.positionOfByte(offset), message, SyntaxError::Kind::Encoding);
+  }
+
   [[noreturn]] void fail(const ParseFailure& parser) {
     if (source_.cancelled) throw Cancelled();
     if (source_.tooLarge()) {
@@ -609,9 +672,12 @@ class Reader {
     }
     if (parser.error == YAML_READER_ERROR) {
       // Bytes that are not UTF-8 text: libyaml gives the byte offset, not the place.
-      const TextPosition where = source_.positionOfByte(parser.problem_offset);
       const std::string problem = parser.problem != nullptr ? parser.problem : "";
       const int value = parser.problem_value;
+      if (problem.find("UTF-8") != std::string::npos || problem == "invalid Unicode character") {
+        throw notUtf8(parser.problem_offset, problem);
+      }
+      const TextPosition where = source_.positionOfByte(parser.problem_offset);
       std::string message;
       if (problem == "control characters are not allowed") {
         message =
@@ -621,8 +687,7 @@ class Reader {
                  problem.find("surrogate") != std::string::npos) {
         message = "the file is not valid UTF-16 text here (" + problem + ")";
       } else {
-        message = fmt::format("the file is not UTF-8 text here (byte 0x{:02X}: {})",
-                              static_cast<unsigned>(value) & 0xFF, problem);
+        message = "the file is not UTF-8 text here (" + problem + ")";
       }
       throw SyntaxError(where, message, SyntaxError::Kind::Encoding);
     }

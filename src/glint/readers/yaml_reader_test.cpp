@@ -179,6 +179,37 @@ TEST(YamlReader, BytesThatAreNotTextAreEncodingErrorsAtTheirPlace) {
   EXPECT_NE(std::string(invalid.what()).find("0xFF"), std::string::npos) << invalid.what();
 }
 
+// Latin-1 text (the usual non-UTF-8 file): the error is at the accented character's own column
+// and names its byte, whatever follows it (libyaml stops at the byte after it, or at the end).
+TEST(YamlReader, ANonUtf8CharacterIsNamedByItsOwnByteAndColumn) {
+  const std::string incomplete = "starts a character the bytes after it do not complete";
+  const std::string latin1 = "(a Latin-1 or Windows-1252 file? save it as UTF-8)";
+  struct Case {
+    std::string text;
+    std::uint32_t line, column;
+    std::string message;
+  };
+  const Case cases[] = {
+      {"a: 1\nname: caf\xe9\n", 2, 10, "byte 0xE9 " + incomplete + " " + latin1},
+      {"a: 1\nname: caf\xe9", 2, 10, "byte 0xE9 " + incomplete + " " + latin1},
+      {"a: 1\nname: caf\xe9 bar\n", 2, 10, "byte 0xE9 " + incomplete + " " + latin1},
+      {"caf\xe9: 1\n", 1, 4, "byte 0xE9 " + incomplete + " " + latin1},
+      {"a: \xf0\x9f\x98x\n", 1, 4, "byte 0xF0 " + incomplete + " " + latin1},
+      {"a: \xc3\xa9\xff\n", 1, 5, "byte 0xFF cannot start a character " + latin1},
+      {"a: \xc0\x80\n", 1, 4, "bytes 0xC0 0x80 are a character in more bytes than UTF-8 allows"},
+      {"a: \xed\xa0\x80\n", 1, 4,
+       "bytes 0xED 0xA0 0x80 are no Unicode character (a surrogate or past U+10FFFF)"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.text);
+    const SyntaxError error = errorOf(c.text);
+    EXPECT_EQ(error.kind(), SyntaxError::Kind::Encoding);
+    EXPECT_EQ(error.where().line, c.line);
+    EXPECT_EQ(error.where().column, c.column);
+    EXPECT_EQ(std::string(error.what()), "the file is not UTF-8 text here: " + c.message);
+  }
+}
+
 TEST(YamlReader, Utf16AndUtf8WithAByteOrderMarkAreRead) {
   // "a: é" in UTF-16LE and UTF-8, each after its byte-order mark.
   const std::string utf16(
