@@ -201,7 +201,7 @@ TEST_F(CliJob, APixelOfBillionsOfRaysWarnsAndStopsWithinASecond) {
       "  - { type: area, shape: disk, center: [0, 3, 0], normal: [0, -1, 0], radius: 0.5,\n"
       "      samples: 65536 }\n";
   writeFile(scene, text);
-  const std::string warning = "absurd.yaml: warning: one pixel may trace about ";
+  const std::string warning = "absurd.yaml:1:1: warning: one pixel may trace about ";
   const RunResult check = run({"check", scene});
   ASSERT_EQ(check.status, 0) << check.err;
   EXPECT_TRUE(contains(check.err, warning)) << check.err;

@@ -699,7 +699,7 @@ class Builder {
         if (shows(mesh.emission, mesh.materialIndex)) return;
       }
     }
-    sink_.warning({d_.files.at(0)->name, 0, 0},
+    sink_.warning({d_.files.at(0)->name, 1, 1},
                   "the scene has no lights, no ambient light and no emissive, reflective or "
                   "transparent objects: every object will render black");
   }
@@ -736,7 +736,7 @@ class Builder {
                                       type));
     }
     if (dark > kMaxDarkObjectWarnings) {
-      sink_.warning({d_.files.at(0)->name, 0, 0},
+      sink_.warning({d_.files.at(0)->name, 1, 1},
                     fmt::format("{} more objects reflect no light", dark - kMaxDarkObjectWarnings));
     }
   }

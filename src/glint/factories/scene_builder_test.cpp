@@ -582,7 +582,7 @@ TEST(SceneBuilder, Warnings) {
       "dark.yaml");
   ASSERT_EQ(dark.warnings.size(), 1u);
   EXPECT_EQ(dark.warnings[0].severity, Diagnostic::Severity::Warning);
-  EXPECT_THAT(dark.warnings[0].format(), HasSubstr("dark.yaml: warning: the scene has no lights"));
+  EXPECT_THAT(dark.warnings[0].format(), HasSubstr("dark.yaml:1:1: warning: the scene has no lights"));
 
   const LoadedScene off =
       loadSceneFromString(std::string(kMinimal) +

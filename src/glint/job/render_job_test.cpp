@@ -169,7 +169,7 @@ TEST_F(RenderJobTest, ErrorsCarryTheirExitStatusAndScenesTheirPlaces) {
                                   "': unknown image format '.jpg'; use .png, .ppm or .exr")
                                      .c_str());
   fs::create_directory(folder_ / "taken.png");
-  EXPECT_EQ(failure(spec("taken.png")).exitCode(), 1) << "a folder in the way: a write failure";
+  EXPECT_EQ(failure(spec("taken.png")).exitCode(), 2) << "a folder in the way: a wrong argument";
 
   // The output may not be an input: here the scene file itself.
   fs::copy_file(kSmallScene, folder_ / "scene.png");

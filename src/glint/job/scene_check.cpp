@@ -125,7 +125,7 @@ std::optional<Diagnostic> pixelWorkWarning(const std::string& file, const SceneP
       1 + static_cast<double>(work.shadowRaysPerHit) + static_cast<double>(work.glossyRaysPerHit);
   return Diagnostic{
       Diagnostic::Severity::Warning,
-      {file, 0, 0},
+      {file, 1, 1},  // the whole scene's: no natural place (DESIGN.md §7: line 1)
       fmt::format("one pixel may trace about {} rays ({} {} × {} surface {} per sample × {} rays "
                   "per hit: {} shadow, {} glossy and the ray to the hit), more than {}; the render "
                   "may never finish. Lower image.samples, image.adaptive.max_samples, the area "
