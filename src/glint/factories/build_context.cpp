@@ -61,7 +61,11 @@ bool checkInRange(ParameterDictionary& params, const Located<std::int64_t>& v, s
                   std::int64_t hi, const std::string& path) {
   if (v.value >= lo && v.value <= hi) return true;
   if (hi == std::numeric_limits<int>::max()) {
-    params.error(v.where, fmt::format("{} must be >= {}, got {}", path, lo, v.value));
+    // The upper bound only keeps the value in an int: said when it is the one broken.
+    params.error(v.where, v.value < lo ? fmt::format("{} must be >= {}, got {}", path, lo, v.value)
+                                       : fmt::format("{} must be at most {} (the largest integer "
+                                                     "glint keeps), got {}",
+                                                     path, hi, v.value));
   } else {
     params.error(v.where,
                  fmt::format("{} must be between {} and {}, got {}", path, lo, hi, v.value));

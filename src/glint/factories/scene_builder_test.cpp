@@ -377,6 +377,9 @@ TEST(SceneBuilder, ImageAndCameraRanges) {
                  "image.samples must be between 1 and 65536");
   expectOneError(camera + "image: {width: 4, height: 3, grid: {interval: 0}}\n", 2, 47,
                  "image.grid.interval must be >= 1, got 0");
+  expectOneError(camera + "image: {width: 4, height: 3, grid: {interval: 2147483648}}\n", 2, 47,
+                 "image.grid.interval must be at most 2147483647 (the largest integer glint "
+                 "keeps), got 2147483648");
   const std::string image = "image: {width: 4, height: 3}\n";
   expectOneError("camera: {position: [0, 0, 0], direction: [0, 0, -1], fov: 180}\n" + image, 1, 59,
                  "camera.fov must be in (0, 180) degrees, got 180");
