@@ -13,6 +13,14 @@ inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // An axis-aligned box [lo, hi]. Default-constructed it is empty (lo = +inf, hi = -inf), so uniting
 // with anything gives that thing. Unbounded shapes (planes, tubes) report infinite extents.
+// How far from the origin a scene may reach, in every space (world, an object's own): the
+// intersection tests multiply up to three coordinates (the watertight triangle test's scaled
+// distance), and a point light's attenuation squares a distance, so farther coordinates would
+// overflow to infinity and the object or light silently vanish. 1e100 is ~10^74 times the
+// observable universe in metres. Points of a scene file past it are errors at the value
+// (ValueReader::point3); objects, which transforms and sizes may carry past it, at the object.
+inline constexpr double kMaxCoordinate = 1e100;
+
 struct Bounds3 {
   Point3 lo{kInfinity, kInfinity, kInfinity};
   Point3 hi{-kInfinity, -kInfinity, -kInfinity};

@@ -157,10 +157,15 @@ TEST(HostileScenes, NumbersAreWhatTheySay) {
   EXPECT_NEAR(light.x, std::sqrt(0.5), 1e-15);
   EXPECT_NEAR(light.y, -std::sqrt(0.5), 1e-15);
   const LoadedScene far = loadSceneFromString(
-      "camera: {position: [0, 0, 1e200], look_at: [0, 0, 0], fov: 40}\n"
+      "camera: {position: [0, 0, 1e100], look_at: [0, 0, -1e100], fov: 40}\n"
       "image: {width: 4, height: 3}\n",
       "far.yaml");
   EXPECT_EQ(far.parts.camera.direction, (Vec3{0, 0, -1}));
+  // Past the scene's reach (kMaxCoordinate): refused, not overflowed into a black image.
+  expectOneError(
+      "camera: {position: [0, 0, 1e200], look_at: [0, 0, 0], fov: 40}\n"
+      "image: {width: 4, height: 3}\n",
+      1, 20, "camera.position must lie within ±1e+100 of the origin, got [0, 0, 1e+200]");
   // Still refused: a zero vector, and 1e400 (infinite).
   expectOneError(
       "camera: {position: [0, 0, 0], direction: [0, 0, -0], fov: 40}\n"

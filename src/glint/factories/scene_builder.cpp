@@ -571,6 +571,17 @@ class Builder {
     anyUv = anyUv || takesMaterial;
     std::vector<TriangleMesh> meshes =
         instantiateMesh(*file, worldFromFile, request.smooth, options_.cancel, anyUv);
+    // Within reach in the world (a file's floats are, but a transform may scale them past it).
+    double reach = 0;
+    for (const TriangleMesh& mesh : meshes) {
+      for (const Point3& p : mesh.positions) {
+        reach = std::max({reach, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+      }
+    }
+    if (reach > kMaxCoordinate) {
+      params.error(params.place(), fmt::format("mesh file '{}' {}", shown, beyondReach(reach)));
+      return;
+    }
     const auto objectTransform =
         worldFromFile ? std::make_shared<const Transform>(*worldFromFile) : nullptr;
     for (std::size_t k = 0; k < meshes.size(); ++k) {

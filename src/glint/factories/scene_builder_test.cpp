@@ -458,6 +458,38 @@ TEST(SceneBuilder, UndefinedMaterialIsNamed) {
       4, 60, "undefined material 'steel'; no materials are defined");
 }
 
+// Points past ±1e100 are errors at the value; objects that sizes or transforms carry past it at
+// the object (the tests multiply up to three coordinates: beyond, a product overflows and the
+// object vanished from the image without a word).
+TEST(SceneBuilder, TheSceneMustLieWithinReachOfTheOrigin) {
+  const std::string objects = std::string(kMinimal) + "objects:\n  - ";
+  expectOneError(objects + "{type: sphere, center: [0, 0, -2e155], radius: 1}\n", 4, 28,
+                 "sphere.center must lie within ±1e+100 of the origin, got [0, 0, -2e+155]");
+  expectOneError(objects + "{type: sphere, center: [0, 0, 0], radius: 1e150}\n", 4, 5,
+                 "objects[0] (sphere): the object reaches 1e+150 from the origin, beyond the "
+                 "±1e+100 glint computes in");
+  expectOneError(objects +
+                     "{type: sphere, center: [0, 0, 0], radius: 1, transform: [{scale: "
+                     "1e30}, {translate: [0, 0, 2e100]}]}\n",
+                 4, 5, "objects[0] (sphere): the object reaches 2e+100 from the origin");
+  expectOneError(objects + "{type: triangle, vertices: [[0, 0, 0], [1, 0, 0], [0, 1e101, 0]]}\n", 4,
+                 55, "triangle.vertices[2] must lie within ±1e+100 of the origin");
+  expectOneError(std::string(kMinimal) +
+                     "lights:\n  - {type: point, position: [0, 1e300, 0], color: [1, 1, 1]}\n",
+                 4, 29, "point light.position must lie within ±1e+100 of the origin");
+  expectOneError(
+      "camera: {position: [0, 0, 1e300], look_at: [0, 0, 0], fov: 40}\n"
+      "image: {width: 4, height: 3}\n",
+      1, 20, "camera.position must lie within ±1e+100 of the origin");
+  // Up to the limit, and an unbounded plane anywhere within it.
+  EXPECT_EQ(loadSceneFromString(objects + "{type: sphere, center: [0, 0, -2e99], radius: 1e99}\n"
+                                          "  - {type: plane, point: [0, 0, -1e100], normal: [0, 0, "
+                                          "1]}\n",
+                                "near.yaml")
+                .parts.primitives.size(),
+            2u);
+}
+
 TEST(SceneBuilder, DegenerateShapesAtTheKeyTheyName) {
   // The factory's refusal is reported at the value of the key it names, else at the object.
   const auto expectShapeError = [](const std::string& object, const std::string& key,
@@ -585,7 +617,8 @@ TEST(SceneBuilder, Warnings) {
       "dark.yaml");
   ASSERT_EQ(dark.warnings.size(), 1u);
   EXPECT_EQ(dark.warnings[0].severity, Diagnostic::Severity::Warning);
-  EXPECT_THAT(dark.warnings[0].format(), HasSubstr("dark.yaml:1:1: warning: the scene has no lights"));
+  EXPECT_THAT(dark.warnings[0].format(),
+              HasSubstr("dark.yaml:1:1: warning: the scene has no lights"));
 
   const LoadedScene off =
       loadSceneFromString(std::string(kMinimal) +

@@ -33,6 +33,15 @@ class ShapeError : public std::invalid_argument {
   std::string parameter_;
 };
 
+// The largest finite |coordinate| of a box (the infinite ones of an unbounded shape left out; a
+// bounded shape's box is infinite only past checks that come first: a point past kMaxCoordinate,
+// a transform whose determinant overflows).
+double reachOf(const Bounds3& bounds);
+
+// "reaches 2e+155 from the origin, beyond the ±1e+100 glint computes in (...)": the reason an
+// object past kMaxCoordinate (core/bounds.h) is refused.
+std::string beyondReach(double reach);
+
 // Closest-hit result of one shape, in the space of the ray that was passed in.
 struct ShapeHit {
   double t = 0;    // ray parameter of the hit, tMin < t < tMax

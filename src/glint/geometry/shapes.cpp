@@ -112,10 +112,26 @@ Normal3 requirePlanarLoop(const Point3* vertices, std::size_t count) {
                                                format(vertices[i])));
   }
   const Vec3 newell = newellVector(vertices, count);
-  if (length(newell) <= kCollinearTolerance * size * size)
+  if (length(newell) <= kCollinearTolerance * size * size) {
+    // No area: the points lie on a line, or the loop crosses itself so that its parts enclose
+    // opposite areas that cancel (a symmetric bow tie). Off the line through vertices[0] and the
+    // vertex farthest from it, some vertex lies away in the second case.
+    std::size_t far = 0;
+    for (std::size_t i = 1; i < count; ++i) {
+      if (distance(vertices[0], vertices[i]) > distance(vertices[0], vertices[far])) far = i;
+    }
+    const Vec3 axis = vertices[far] - vertices[0];
+    for (std::size_t i = 1; i < count; ++i) {
+      if (length(cross(axis, vertices[i] - vertices[0])) > kCollinearTolerance * size * size) {
+        throw ShapeError("vertices",
+                         "vertices are self-intersecting: the loop crosses itself and "
+                         "its parts enclose opposite areas that cancel");
+      }
+    }
     throw ShapeError("vertices",
                      fmt::format("vertices are collinear (enclosed area {} for size {})",
                                  0.5 * length(newell), size));
+  }
   const Vec3 n = normalize(newell);
   Vec3 centroid;
   for (std::size_t i = 0; i < count; ++i) centroid += toVec(vertices[i]);
@@ -887,6 +903,24 @@ Ray objectRayOf(const Transform& worldFromObject, const Ray& r) {
        m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z}};
 }
 
+double reachOf(const Bounds3& bounds) {
+  double reach = 0;
+  for (const Point3& corner : {bounds.lo, bounds.hi}) {
+    for (const double c : {corner.x, corner.y, corner.z}) {
+      if (std::isfinite(c)) reach = std::max(reach, std::abs(c));
+    }
+  }
+  return reach;
+}
+
+std::string beyondReach(double reach) {
+  return fmt::format(
+      "reaches {:g} from the origin, beyond the ±{:g} glint computes in (its double-precision "
+      "intersection tests multiply up to three coordinates, which would overflow): scale the "
+      "scene down",
+      reach, kMaxCoordinate);
+}
+
 Primitive::Primitive(Shape shape, std::uint32_t materialIndex, const Color& emission,
                      std::optional<Transform> worldFromObject)
     : shape_(std::move(shape)), emission_(emission), materialIndex_(materialIndex) {
@@ -896,6 +930,12 @@ Primitive::Primitive(Shape shape, std::uint32_t materialIndex, const Color& emis
   }
   const Bounds3 objectBounds = std::visit([](const auto& s) { return s.bounds(); }, shape_);
   bounds_ = worldFromObject_ ? (*worldFromObject_)(objectBounds) : objectBounds;
+  // Within reach in its own space and in the world.
+  for (const Bounds3& box : {objectBounds, bounds_}) {
+    if (const double reach = reachOf(box); reach > kMaxCoordinate) {
+      throw ShapeError("", "the object " + beyondReach(reach));
+    }
+  }
 }
 
 bool Primitive::intersect(const Ray& ray, double tMin, double tMax, ShapeHit& hit) const {

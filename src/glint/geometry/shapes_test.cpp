@@ -802,6 +802,18 @@ TEST(ShapeQuadrangle, MakeRejectsInvalidQuadrangles) {
                 return Quadrangle::make({0, 0, 0}, {2, 2, 0}, {2, 0, 0}, {0, 3, 0});
               }),
               HasSubstr("vertices are self-intersecting"));
+  // A symmetric bow tie encloses no net area, yet its points are not on a line.
+  const std::string cancel =
+      "vertices are self-intersecting: the loop crosses itself and its parts enclose opposite "
+      "areas that cancel";
+  EXPECT_EQ(errorOf([] {
+              return Quadrangle::make({0, 0, 0}, {1, 1, 0}, {1, 0, 0}, {0, 1, 0});
+            }),
+            cancel);
+  EXPECT_EQ(errorOf([] {
+              return Polygon::make({{0, 0, 0}, {1, 1, 0}, {1, 0, 0}, {0, 1, 0}});
+            }),
+            cancel);
   EXPECT_THAT(errorOf([] {
                 return Quadrangle::make({0, 0, 0}, {1, 0, 0}, {1, 1, 1}, {0, 1, 0});
               }),

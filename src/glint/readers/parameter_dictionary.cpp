@@ -1,5 +1,7 @@
 #include "glint/readers/parameter_dictionary.h"
 
+#include "glint/core/bounds.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -196,6 +198,15 @@ std::optional<Vec3> ValueReader::vec3(ValueId v, ValueId where, const ValuePath&
 std::optional<Point3> ValueReader::point3(ValueId v, ValueId where, const ValuePath& path) const {
   const auto t = triple(v, where, path, "[x, y, z]");
   if (!t) return std::nullopt;
+  for (const double c : *t) {
+    if (std::abs(c) > kMaxCoordinate) {
+      error(where, fmt::format("{} must lie within ±{:g} of the origin, got [{}, {}, {}] (glint's "
+                               "double-precision tests multiply up to three coordinates, which "
+                               "would overflow): scale the scene down",
+                               path.str(), kMaxCoordinate, (*t)[0], (*t)[1], (*t)[2]));
+      return std::nullopt;
+    }
+  }
   return Point3{(*t)[0], (*t)[1], (*t)[2]};
 }
 
@@ -476,7 +487,7 @@ std::optional<Located<ColorValue>> ParameterDictionary::color(std::string_view k
   return get(key, p, &ValueReader::color);
 }
 std::optional<Located<ColorValue>> ParameterDictionary::coefficient(std::string_view key,
-                                                                   Presence p) {
+                                                                    Presence p) {
   return get(key, p, &ValueReader::coefficient);
 }
 std::optional<Located<std::string_view>> ParameterDictionary::text(std::string_view key,
