@@ -87,6 +87,11 @@ TEST_F(Cli, ArgumentParserErrorsExitTwo) {
   r = run({"render", small(), "--width", "abc"});
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "--width")) << r.err;
+  // An option given twice, in glint's words rather than the parser library's.
+  r = run({"render", small(), "--width", "32", "--width", "16"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "--width is given more than once; give it once")) << r.err;
+  EXPECT_FALSE(contains(r.err, "At Most")) << r.err;
   EXPECT_TRUE(filesIn(work_).empty());
 }
 

@@ -520,6 +520,11 @@ int parseFailure(const CLI::ParseError& error) {
              colon != std::string_view::npos && message.ends_with(" missing")) {
     // CLI11 says "--width: 1 required W missing".
     printError(fmt::format("{} needs a value", message.substr(0, colon)));
+  } else if (dynamic_cast<const CLI::ArgumentMismatch*>(&error) &&
+             colon != std::string_view::npos &&
+             message.find("At Most 1 required but received") != std::string_view::npos) {
+    // CLI11 says "--width: At Most 1 required but received 2".
+    printError(fmt::format("{} is given more than once; give it once", message.substr(0, colon)));
   } else {
     printError(message);
   }

@@ -202,6 +202,11 @@ std::string plainProblem(std::string_view problem, std::string_view at) {
   if (problem == "found unexpected end of stream") {
     return "the file ends inside a quoted text (missing closing quote?)";
   }
+  if (problem == "did not find expected hexdecimal number") {
+    // libyaml's words (and spelling) for "\x", "\u" or "\U" without its hexadecimal digits.
+    return "an escape sequence in quoted text lacks its hexadecimal digits (\\xHH, \\uHHHH "
+           "or \\UHHHHHHHH)";
+  }
   if (problem == "found unknown escape character") {
     return "unknown escape sequence in quoted text: " + std::string(at);  // "\\q"
   }

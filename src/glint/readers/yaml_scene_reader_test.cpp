@@ -228,6 +228,11 @@ TEST(SceneParser, SyntaxErrorAtItsMark) {
   expectOneError("camera:\n\tposition: [0, 0, 0]\n", 2, 1, "tabs are not allowed");
   // At the escape sequence itself (yaml-cpp, the reader before libyaml, put it two columns on).
   expectOneError("name: \"a\\qb\"\n", 1, 9, "unknown escape sequence in quoted text: \\q");
+  // libyaml's own words for a \x without its digits ("did not find expected hexdecimal number")
+  // are not shown.
+  expectOneError("name: \"\\xZZ\"\n", 1, 10,
+                 "an escape sequence in quoted text lacks its hexadecimal digits (\\xHH, "
+                 "\\uHHHH or \\UHHHHHHHH)");
 }
 
 TEST(SceneParser, EmptyOrNonMappingFileAtLineOne) {
