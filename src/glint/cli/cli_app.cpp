@@ -579,9 +579,10 @@ int runCommandLine(int argc, char** argv) {
   std::string maxMemory, checkpoint, resume;
   CLI::Option* maxMemoryOption =
       render
-          ->add_option("--max-memory", maxMemory,
-                       "Memory the scene may need (film, meshes, BVH), e.g. 512M, 4G, 1.5GiB or "
-                       "bytes; default: half the physical memory")
+          ->add_option(
+              "--max-memory", maxMemory,
+              "Memory the scene may need (film, meshes, BVH, textures), e.g. 512M, 4G, 1.5GiB or "
+              "bytes; default: half the physical memory")
           ->type_name("SIZE");
   CLI::Option* checkpointOption =
       render

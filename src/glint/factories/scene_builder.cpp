@@ -721,6 +721,7 @@ class Builder {
   void warnAboutDarkObjects() {
     if (sink_.hasErrors() || parts_.lights.empty()) return;
     std::size_t dark = 0;
+    std::optional<SourceLocation> firstUnshown;  // where the count of the rest is said
     for (std::size_t i = 0; i < parts_.primitives.size(); ++i) {
       const Primitive& p = parts_.primitives[i];
       if (!isDark(p.emission(), p.materialIndex())) continue;
@@ -732,9 +733,12 @@ class Builder {
           continue;
         }
       }
-      if (++dark > kMaxDarkObjectWarnings) continue;
       const ObjectPlace& place = objectPlaces_[i];
       const SourceFile& file = *d_.files[place.file];
+      if (++dark > kMaxDarkObjectWarnings) {
+        if (!firstUnshown) firstUnshown = file.location(place.value);
+        continue;
+      }
       const std::string_view type = file.values.scalar(typeValue(file, place.value));
       sink_.warning(file.location(place.value),
                     p.materialIndex() == 0
@@ -747,8 +751,9 @@ class Builder {
                                       type));
     }
     if (dark > kMaxDarkObjectWarnings) {
-      sink_.warning({d_.files.at(0)->name, 1, 1},
-                    fmt::format("{} more objects reflect no light", dark - kMaxDarkObjectWarnings));
+      // At the first object not named, so that the line comes after the five that are.
+      sink_.warning(*firstUnshown, fmt::format("{} more objects reflect no light (this one first)",
+                                               dark - kMaxDarkObjectWarnings));
     }
   }
 

@@ -702,7 +702,10 @@ TEST(SceneBuilder, ObjectsThatReflectNoLightUnderLightsAreWarnings) {
   for (int i = 0; i < 9; ++i) many += "  - {type: sphere, center: [0, 0, -5], radius: 1}\n";
   const LoadedScene manyDark = loadSceneFromString(many, "many.yaml");
   ASSERT_EQ(manyDark.warnings.size(), 6u);
-  EXPECT_THAT(manyDark.warnings[0].format(), HasSubstr("4 more objects reflect no light"));
+  EXPECT_THAT(manyDark.warnings[0].format(), HasSubstr("many.yaml:5:5: warning: sphere has no"));
+  // The count comes after the five named, at the first object it counts.
+  EXPECT_EQ(manyDark.warnings[5].format(),
+            "many.yaml:10:5: warning: 4 more objects reflect no light (this one first)");
 }
 
 // ------------------------------------------------------------------------------------ mesh objects

@@ -2,6 +2,7 @@
 
 #include <sys/mman.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -72,8 +73,11 @@ class MeshFileAccess : public Assimp::DefaultIOSystem {
     FILE* stream = ::fdopen(opened.fd, "rb");
     if (stream == nullptr) return nullptr;
     opened.release();  // the stream closes it
+    opened_.emplace_back(file);
     return new OpenedFileStream(stream, file);
   }
+  // The files opened so far, as the importer named them (the mesh file, an OBJ's MTL files...).
+  const std::vector<std::string>& opened() const { return opened_; }
   // The file opened for reading when the rules allow it (else fd −1, the refusal kept).
   ReadableFile openChecked(const char* file) {
     ReadableFile opened;
@@ -111,7 +115,40 @@ class MeshFileAccess : public Assimp::DefaultIOSystem {
 
   const ReferencedFileRule& rule_;  // outlives the importer (importMesh's caller holds it)
   mutable std::string refusal_;     // set by the first refused file, from the const Exists too
+  std::vector<std::string> opened_;
 };
+
+// The material names an OBJ file's MTL files define (`newmtl NAME`: the rest of the line, blanks
+// trimmed, as assimp reads it): every file the import opened other than the OBJ file itself.
+std::set<std::string> mtlMaterialNames(MeshFileAccess& files, const std::string& objFile) {
+  std::set<std::string> names;
+  for (const std::string& name : files.opened()) {
+    if (name == objFile) continue;
+    const ReadableFile file = files.openChecked(name.c_str());
+    if (file.fd < 0) continue;
+    std::string text;
+    char buffer[1 << 16];
+    for (ssize_t n; (n = ::read(file.fd, buffer, sizeof buffer)) > 0;) {
+      text.append(buffer, static_cast<std::size_t>(n));
+    }
+    const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+    for (std::size_t start = 0; start < text.size();) {
+      std::size_t end = text.find('\n', start);
+      if (end == std::string::npos) end = text.size();
+      std::size_t i = start;
+      while (i < end && blank(text[i])) ++i;
+      if (text.compare(i, 6, "newmtl") == 0 && i + 6 < end && blank(text[i + 6])) {
+        std::size_t from = i + 6;
+        std::size_t to = end;
+        while (from < to && blank(text[from])) ++from;
+        while (to > from && blank(text[to - 1])) --to;
+        names.emplace(text, from, to - from);
+      }
+      start = end + 1;
+    }
+  }
+  return names;
+}
 
 // Leaves `importer` with only the importer(s) for `extension`: the glTF 2.0 one for .gltf/.glb
 // (not assimp's glTF 1.0 importer), the one importer of each other extension. assimp falls back to
@@ -201,7 +238,8 @@ void convertTextures(const aiScene& scene, const aiMaterial& m, MeshMaterial& ou
   }
 }
 
-MeshMaterial convertMaterial(const aiMaterial& m) {
+// `objDefined`: for an OBJ file, the names its MTL files define (else null).
+MeshMaterial convertMaterial(const aiMaterial& m, const std::set<std::string>* objDefined) {
   MeshMaterial out;
   aiString name;
   const bool named = m.Get(AI_MATKEY_NAME, name) == AI_SUCCESS;
@@ -210,8 +248,13 @@ MeshMaterial convertMaterial(const aiMaterial& m) {
   const bool hasBase = m.Get(AI_MATKEY_BASE_COLOR, base) == AI_SUCCESS;
   // assimp's stand-in when the file has no material: named AI_DEFAULT_MATERIAL_NAME (STL, OBJ
   // without MTL) or, from the PLY reader, without any name. glTF materials carry a base colour
-  // even when unnamed (and glTF's own default material is white by its specification).
-  if ((named && out.name == AI_DEFAULT_MATERIAL_NAME) || (!named && !hasBase)) {
+  // even when unnamed (and glTF's own default material is white by its specification). An OBJ's
+  // `usemtl` of a name no MTL file defines (the MTL missing, or another one) is assimp's own
+  // stand-in too (diffuse 0.6): the file has no material for it either.
+  const bool undefinedObjMaterial =
+      objDefined != nullptr && named && objDefined->count(out.name) == 0;
+  if ((named && out.name == AI_DEFAULT_MATERIAL_NAME) || (!named && !hasBase) ||
+      undefinedObjMaterial) {
     out.material = kMeshDefaultMaterial;
     out.fromFile = false;
     return out;
@@ -367,6 +410,8 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
     const aiScene* scene = importer.ReadFile(path.string(), 0);
     if (!files->refusal().empty()) throw MeshLoadError(files->refusal());
     if (scene == nullptr) throw MeshLoadError(assimpReason(importer.GetErrorString()));
+    std::optional<std::set<std::string>> objDefined;
+    if (extension == ".obj") objDefined = mtlMaterialNames(*files, path.string());
     // The importer owns the scene and its steps edit it in place; so does dropInvalidFaces.
     result.droppedTriangles = dropInvalidFaces(const_cast<aiScene&>(*scene));
     splitSharedCorners(const_cast<aiScene&>(*scene));
@@ -431,7 +476,8 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
       if (source < scene->mNumMaterials && scene->mMaterials[source] != nullptr) {
         if (materialOf[source] == kUnused) {
           materialOf[source] = static_cast<std::uint32_t>(result.materials.size());
-          result.materials.push_back(convertMaterial(*scene->mMaterials[source]));
+          result.materials.push_back(
+              convertMaterial(*scene->mMaterials[source], objDefined ? &*objDefined : nullptr));
           convertTextures(*scene, *scene->mMaterials[source], result.materials.back(),
                           result.embeddedImages, embeddedFrom);
         }

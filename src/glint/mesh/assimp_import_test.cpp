@@ -134,6 +134,34 @@ TEST(MeshImport, ObjWithMtlTrianglesBoundsAndDiffuseColours) {
   EXPECT_EQ(file.materials.size(), facts.trianglesByMaterial.size());
 }
 
+// An OBJ's `usemtl` of a name no MTL file defines (the MTL left behind, or another one) has no
+// material from the file: the mid-grey default, as an OBJ without `usemtl` — not the 0.6 grey
+// assimp makes up for it.
+TEST(MeshImport, AnObjMaterialNoMtlDefinesIsTheDefaultMaterial) {
+  TempDir dir;
+  const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  dir.write("have.mtl", "# one material\n  newmtl  red  \r\nKd 1 0 0\n");
+  struct Case {
+    const char* name;
+    std::string text;
+    bool fromFile;
+  };
+  const Case cases[] = {
+      {"no_usemtl", triangle + "f 1 2 3\n", false},
+      {"mtl_missing", "mtllib missing.mtl\nusemtl red\n" + triangle + "f 1 2 3\n", false},
+      {"no_mtllib", "usemtl red\n" + triangle + "f 1 2 3\n", false},
+      {"defined", "mtllib have.mtl\nusemtl red\n" + triangle + "f 1 2 3\n", true},
+      {"another_name", "mtllib have.mtl\nusemtl blue\n" + triangle + "f 1 2 3\n", false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const MeshFile file = readMeshFile(dir.write(std::string(c.name) + ".obj", c.text));
+    ASSERT_EQ(file.materials.size(), 1u);
+    EXPECT_EQ(file.materials[0].fromFile, c.fromFile);
+    EXPECT_EQ(file.materials[0].material.kd, c.fromFile ? Color(1, 0, 0) : Color(0.7));
+  }
+}
+
 TEST(MeshImport, MtlSpecularShininessAndTheFilesOwnNormals) {
   // cube_usemtl: 12 faces over materials mtl (Ks 0.05, Ns 200), mtl2 (Ks 0.375, Ns 16) and mtl3,
   // which the MTL does not define; every face has a `vn` normal along an axis.

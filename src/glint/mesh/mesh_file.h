@@ -71,8 +71,8 @@ std::optional<MeshErrorPlace> meshErrorPlace(const std::string& reason);
 //   emissive colour → emission; opacity < 1 → kt = 1 − opacity, with the refraction index → ior.
 // Textures (MeshTexture) are named, not read: the scene builder reads them (DESIGN.md §9).
 // Vertex colours and PBR parameters other than the base colour are ignored.
-// A material assimp made up because the file has none (STL, PLY, OBJ without MTL) is
-// kMeshDefaultMaterial instead, with fromFile false.
+// A material assimp made up because the file has none (STL, PLY, OBJ without MTL, an OBJ's
+// `usemtl` of a name no MTL file defines) is kMeshDefaultMaterial instead, with fromFile false.
 // A texture a mesh file's material names: a file, as the mesh file wrote it (relative to the mesh
 // file's folder), or an image embedded in the mesh file (a .glb's buffers, a data: URI).
 struct MeshTexture {
