@@ -5,7 +5,6 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
-#include <vector>
 
 namespace glint {
 
@@ -82,23 +81,25 @@ std::string counted(std::uint64_t count, Kind kind) {
   return fmt::format("{} {}", count, count == 1 ? kOneName[kind] : kManyNames[kind]);
 }
 
-// The file read statement by statement, once. A positive index past the vertices of its kind so
-// far may name one further down: such a forward reference is kept, and judged against the whole
-// file's count at the end (the rest of the file is counted after a fault when one is kept, since
-// it would come first).
+// The file read statement by statement, once — twice when a face names a vertex further down
+// (OBJ allows it): the first pass then counts the whole file (past a fault too), and the second
+// judges every positive index against those totals, so the first fault in the file is the one
+// said. Memory stays constant whatever the file.
 class Checker {
  public:
   explicit Checker(std::string_view text) : text_(text) {}
 
   std::optional<ObjFault> run() {
     scan();
-    for (const ForwardIndex& forward : forwards_) {
-      if (forward.value > seen_[forward.kind]) {
-        return ObjFault{forward.line, forward.column,
-                        fmt::format("{} index {} is past the file's {}", kIndexNames[forward.kind],
-                                    forward.word, counted(seen_[forward.kind], forward.kind))};
-      }
-    }
+    if (!forwardSeen_) return fault_;
+    totals_ = seen_;
+    secondPass_ = true;
+    p_ = 0;
+    line_ = 1;
+    lineStart_ = 0;
+    seen_ = {};
+    fault_.reset();
+    scan();
     return fault_;
   }
 
@@ -137,7 +138,7 @@ class Checker {
   }
 
   void scan() {
-    while (p_ < text_.size() && (!fault_ || !forwards_.empty())) {
+    while (p_ < text_.size() && (!fault_ || (forwardSeen_ && !secondPass_))) {
       if (!blank(text_[p_]) && !lineEnd(text_[p_])) statement();
       // The rest of the line (a comment, or what a skipped statement holds), then its end.
       while (p_ < text_.size() && !lineEnd(text_[p_])) {
@@ -204,7 +205,13 @@ class Checker {
                               kIndexNames[kind], word, kOneName[kind],
                               seen_[kind] == 1 ? "1 is" : fmt::format("{} are", seen_[kind])));
     }
-    if (!negative && value > seen_[kind]) forwards_.push_back({line_, column, word, kind, value});
+    if (negative) return;
+    if (!secondPass_) {
+      forwardSeen_ = forwardSeen_ || value > seen_[kind];
+    } else if (value > totals_[kind]) {
+      fail(column, fmt::format("{} index {} is past the file's {}", kIndexNames[kind], word,
+                               counted(totals_[kind], kind)));
+    }
   }
 
   // One corner: v, v/vt, v//vn or v/vt/vn, each index [+-]digits.
@@ -250,15 +257,11 @@ class Checker {
   std::size_t p_ = 0;
   std::size_t line_ = 1;
   std::size_t lineStart_ = 0;
-  std::array<std::uint64_t, kKinds> seen_{};  // vertices of each kind so far
-  struct ForwardIndex {
-    std::size_t line, column;
-    std::string_view word;
-    Kind kind;
-    std::uint64_t value;
-  };
-  std::vector<ForwardIndex> forwards_;  // in file order
-  std::optional<ObjFault> fault_;       // the first fault other than a forward index
+  std::array<std::uint64_t, kKinds> seen_{};    // vertices of each kind so far
+  std::array<std::uint64_t, kKinds> totals_{};  // in the whole file (the second pass)
+  bool forwardSeen_ = false;                    // a positive index past the vertices so far
+  bool secondPass_ = false;
+  std::optional<ObjFault> fault_;
 };
 
 }  // namespace
