@@ -26,9 +26,9 @@ std::uint32_t MeshCollector::vertexIndex(const ValueTree& tree, Group& g,
   return it->second;
 }
 
-void MeshCollector::add(ValueTree& tree, const std::string& material,
-                        const CollectedVertex& a, const CollectedVertex& b,
-                        const CollectedVertex& c, const TextPosition& at) {
+void MeshCollector::add(ValueTree& tree, const std::string& material, const CollectedVertex& a,
+                        const CollectedVertex& b, const CollectedVertex& c,
+                        const TextPosition& at) {
   const bool normals = a.normal[0] != kNoValue;
   const bool colors = a.color[0] != kNoValue;
   const std::string key = material + (normals ? "\n1" : "\n0") + (colors ? "1" : "0");

@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "glint/core/bounds.h"
 #include "glint/core/cancel.h"
 #include "glint/core/vec.h"
 #include "glint/readers/mesh_collector.h"
@@ -25,7 +26,12 @@ const std::vector<std::string_view> kStatements = {"v", "b", "l", "f", "c", "s",
 constexpr std::size_t kStatementsPerPoll = 4096;
 // Vertices one polygon may have: far beyond any SPD polygon (the gears' 144), small enough that
 // ear clipping (quadratic in the vertices) stays fast.
-constexpr double kMaxPolygonVertices = 1 << 16;
+// Ear clipping (triangulate) takes time growing with the square of a polygon's corners or
+// faster: 4096 take ~0.5 s at worst (a star), 65536 took minutes. The SPD's largest is 144.
+constexpr double kMaxPolygonVertices = 4096;
+// A polygon vertex farther than this fraction of the polygon's size from its plane is warned
+// about: generated files write ~6 digits, far below it; a real bend is far above.
+constexpr double kPolygonPlaneTolerance = 1e-4;
 
 struct Fill {
   std::string name;
@@ -391,12 +397,30 @@ class NffReader {
       points[i] = Point3{v[0], v[1], v[2]};
     }
     const std::string m = material(false);
-    const std::vector<std::array<std::size_t, 3>> triangles = triangulate(points);
+    bool fanned = false;
+    const std::vector<std::array<std::size_t, 3>> triangles = triangulate(points, cancel_, fanned);
     if (triangles.empty()) {
-      out_.warning(p.at, fmt::format("{}: the polygon's vertices are collinear (no area); it is "
-                                     "left out",
-                                     p.text));
+      out_.warning(p.at, fmt::format("{}: the polygon{}; it is left out", p.text,
+                                     collinear(points) ? "'s vertices are collinear (no area)"
+                                                       : " crosses itself so that its parts "
+                                                         "enclose opposite areas that cancel"));
       return;
+    }
+    if (const long turns = windings(points); turns > 1) {
+      out_.warning(p.at, fmt::format("{}: the polygon winds around {} times (it crosses itself, "
+                                     "as a star drawn in one stroke); its triangles may cover "
+                                     "other parts than meant",
+                                     p.text, turns));
+    } else if (fanned) {
+      out_.warning(p.at, fmt::format("{}: the polygon crosses itself or repeats a vertex, so ear "
+                                     "clipping cannot cut it; the rest of it is a fan of "
+                                     "triangles, which may cover other parts than meant",
+                                     p.text));
+    }
+    if (const double off = offPlane(points); off > kPolygonPlaneTolerance) {
+      out_.warning(p.at, fmt::format("{}: the polygon is not planar (a vertex lies {:.3g} of its "
+                                     "size off its plane); its triangles follow the vertices",
+                                     p.text, off));
     }
     for (const auto& tri : triangles) {
       meshes_.add(tree, m, vertices[tri[0]], vertices[tri[1]], vertices[tri[2]], p.at);
@@ -407,7 +431,73 @@ class NffReader {
   // normal (Newell's) is most perpendicular to. Triangles keep the polygon's vertex order. A
   // polygon that clipping cannot finish (self-intersecting, repeated vertices) gets a fan for the
   // rest.
-  static std::vector<std::array<std::size_t, 3>> triangulate(const std::vector<Point3>& p) {
+  // How many times the boundary winds around, from its turning angles in the coordinate plane its
+  // Newell normal is most perpendicular to (1 for a simple polygon, 2 for a pentagram).
+  static long windings(const std::vector<Point3>& p) {
+    const std::size_t n = p.size();
+    Vec3 normal;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Point3& a = p[i];
+      const Point3& b = p[(i + 1) % n];
+      normal +=
+          Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
+    }
+    const Vec3 an = abs(normal);
+    const int drop = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+    double total = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Point3& a = p[(i + n - 1) % n];
+      const Point3& b = p[i];
+      const Point3& c = p[(i + 1) % n];
+      const double eu = b[(drop + 1) % 3] - a[(drop + 1) % 3];
+      const double ew = b[(drop + 2) % 3] - a[(drop + 2) % 3];
+      const double fu = c[(drop + 1) % 3] - b[(drop + 1) % 3];
+      const double fw = c[(drop + 2) % 3] - b[(drop + 2) % 3];
+      total += std::atan2(eu * fw - ew * fu, eu * fu + ew * fw);
+    }
+    return std::lround(std::abs(total) / (2 * std::numbers::pi));
+  }
+
+  // Whether all points lie on one line (through the first and the one farthest from it).
+  static bool collinear(const std::vector<Point3>& p) {
+    std::size_t far = 0;
+    for (std::size_t i = 1; i < p.size(); ++i) {
+      if (distance(p[0], p[i]) > distance(p[0], p[far])) far = i;
+    }
+    const Vec3 axis = p[far] - p[0];
+    const double size = length(axis);
+    for (const Point3& q : p) {
+      if (length(cross(axis, q - p[0])) > 1e-12 * size * size) return false;
+    }
+    return true;
+  }
+
+  // The largest distance of a vertex from the polygon's plane (through its centroid, normal
+  // Newell's), relative to the polygon's size (its bounding box diagonal); 0 without a normal.
+  static double offPlane(const std::vector<Point3>& p) {
+    Vec3 normal;
+    Vec3 centroid;
+    Bounds3 box;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Point3& a = p[i];
+      const Point3& b = p[(i + 1) % p.size()];
+      normal +=
+          Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
+      centroid += toVec(a);
+      box = unite(box, a);
+    }
+    const double size = length(box.diagonal());
+    if (!(length(normal) > 0) || !(size > 0)) return 0;
+    const Vec3 n = normalize(normal);
+    centroid = centroid / static_cast<double>(p.size());
+    double off = 0;
+    for (const Point3& q : p) off = std::max(off, std::abs(dot(toVec(q) - centroid, n)));
+    return off / size;
+  }
+
+  static std::vector<std::array<std::size_t, 3>> triangulate(const std::vector<Point3>& p,
+                                                             const std::atomic<bool>* cancel,
+                                                             bool& fanned) {
     const std::size_t n = p.size();
     Vec3 normal;
     for (std::size_t i = 0; i < n; ++i) {
@@ -430,6 +520,7 @@ class NffReader {
     std::vector<std::size_t> ring(n);
     for (std::size_t i = 0; i < n; ++i) ring[i] = i;
     while (ring.size() > 3) {
+      throwIfCancelled(cancel);  // a large polygon takes a while: Ctrl-C must not wait for it
       const std::size_t m = ring.size();
       bool clipped = false;
       for (std::size_t i = 0; i < m && !clipped; ++i) {
@@ -451,6 +542,7 @@ class NffReader {
         clipped = true;
       }
       if (!clipped) {
+        fanned = true;
         for (std::size_t i = 1; i + 1 < ring.size(); ++i) {
           out.push_back({ring[0], ring[i], ring[i + 1]});
         }

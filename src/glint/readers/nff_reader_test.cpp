@@ -6,7 +6,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "glint/factories/scene_loader.h"
 
@@ -128,6 +132,68 @@ TEST(NffReader, EveryStatementBecomesTheEntitiesOfAYamlScene) {
   EXPECT_NEAR(area, 27, 1e-9);
 }
 
+std::vector<std::string> warningsOf(const ParseResult& r) {
+  std::vector<std::string> out;
+  for (const Diagnostic& d : r.diagnostics) {
+    if (d.severity == Diagnostic::Severity::Warning) out.push_back(d.format());
+  }
+  return out;
+}
+
+// Polygons ear clipping cannot cut as meant are said, not drawn wrong in silence; a polygon past
+// the corner limit is refused before its (quadratic) triangulation.
+TEST(NffReader, PolygonsThatCrossThemselvesOrBendAreWarnedAbout) {
+  const std::string view =
+      "v from 0 3 0 at 0 0 0 up 0 0 1 angle 60 hither 0.01 resolution 8 8\n"
+      "l 1 3 1\nf 1 0 0 0.5 0.5 3 0 1\n";
+  std::string star = "p 5\n";
+  for (int k = 0; k < 5; ++k) {
+    const double phi = (90 + 144 * k) * std::numbers::pi / 180;
+    star += fmt::format("{} 0 {}\n", std::cos(phi), std::sin(phi));
+  }
+  EXPECT_EQ(warningsOf(parseNff(view + star, "a.nff")),
+            std::vector<std::string>{"a.nff:4:1: warning: p: the polygon winds around 2 times (it "
+                                     "crosses itself, as a star drawn in one stroke); its "
+                                     "triangles may cover other parts than meant"});
+  EXPECT_EQ(warningsOf(parseNff(view + "p 4\n-1 0 -1\n1 0 1\n1 0 -1\n-1 0 1\n", "a.nff")),
+            std::vector<std::string>{"a.nff:4:1: warning: p: the polygon crosses itself so that "
+                                     "its parts enclose opposite areas that cancel; it is left "
+                                     "out"});
+  EXPECT_EQ(warningsOf(parseNff(view + "p 3\n0 0 0\n1 0 0\n2 0 0\n", "a.nff")),
+            std::vector<std::string>{"a.nff:4:1: warning: p: the polygon's vertices are collinear "
+                                     "(no area); it is left out"});
+  EXPECT_EQ(warningsOf(parseNff(view + "p 4\n0 0 0\n1 0 0\n1 1 1\n0 0 1\n", "a.nff")),
+            std::vector<std::string>{"a.nff:4:1: warning: p: the polygon is not planar (a vertex "
+                                     "lies 0.118 of its size off its plane); its triangles follow "
+                                     "the vertices"});
+  // A concave polygon (an L) is cut without a word.
+  EXPECT_TRUE(
+      warningsOf(parseNff(view + "p 6\n0 0 0\n2 0 0\n2 0 1\n1 0 1\n1 0 2\n0 0 2\n", "a.nff"))
+          .empty());
+  std::string big = "p 4097\n";
+  for (int i = 0; i < 4097; ++i) big += "0 0 0\n";
+  EXPECT_EQ(firstError(parseNff(view + big, "a.nff")),
+            "a.nff:4:3: p: the number of vertices must be a whole number from 3 to 4096, got 4097");
+}
+
+// Text that is no text: a NUL byte is refused at its place (it read as a blank); a UTF-8
+// byte-order mark at the start is skipped.
+TEST(NffReader, ANulByteIsRefusedAndAByteOrderMarkSkipped) {
+  const std::string scene =
+      "v from 0 0 5 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 8 8\ns 0 0 0 1\n";
+  try {
+    parseNff(std::string("v from 0 0 5\ns 0 0 0\0 1\n", 24), "nul.nff");
+    ADD_FAILURE() << "not refused";
+  } catch (const SceneError& e) {
+    ASSERT_EQ(e.diagnostics().size(), 1u);
+    EXPECT_EQ(e.diagnostics()[0].format(),
+              "nul.nff:2:8: the file holds a NUL byte here; a scene file is text");
+  }
+  const ParseResult bom = parseNff("\xEF\xBB\xBF" + scene, "bom.nff");
+  EXPECT_FALSE(bom.hasErrors()) << firstError(bom);
+  EXPECT_EQ(count(bom, EntityKind::ObjectEntity), 1u);
+}
+
 TEST(NffReader, ErrorsNameTheirLineAndColumn) {
   const auto error = [](const std::string& body) {
     return firstError(parseNff(
@@ -146,7 +212,7 @@ TEST(NffReader, ErrorsNameTheirLineAndColumn) {
             "bad.nff:2:9: c: a negative radius needs the other one negative too (both negative: "
             "only the inside is visible)");
   EXPECT_EQ(error("p 2\n0 0 0 1 1 1\n"),
-            "bad.nff:2:3: p: the number of vertices must be a whole number from 3 to 65536, got 2");
+            "bad.nff:2:3: p: the number of vertices must be a whole number from 3 to 4096, got 2");
   EXPECT_THAT(firstError(parseNff("s 0 0 0 1\n", "none.nff")),
               HasSubstr("none.nff:1:1: the file has no viewpoint"));
   EXPECT_EQ(firstError(parseNff("v from 0 0 5 at 0 0 0 up 0 1 0 angle 180 hither 1 resolution 8 8",

@@ -40,6 +40,9 @@ constexpr std::size_t kStatementsPerPoll = 1024;
 
 // The supported statement nearest to `word` (always one).
 std::string_view nearestSupported(std::string_view word) {
+  // The distance is quadratic in the word's length: a statement is never longer than this.
+  constexpr std::size_t kLongestWord = 64;
+  word = word.substr(0, kLongestWord);
   std::string_view best = kSupported[0];
   std::size_t bestDistance = SIZE_MAX;
   for (const std::string_view s : kSupported) {
@@ -323,6 +326,10 @@ class TachyonReader {
     const Triple center = in_.point(t, "light center");
     in_.keyword(t, "RAD");
     const Number radius = in_.number(t, "light radius");
+    if (!(radius.value >= 0)) {
+      out_.error(radius.at, fmt::format("light RAD must be >= 0, got {}", radius.text));
+      throw SyntaxError{};
+    }
     std::optional<Triple> direction;
     Number start, end;
     if (spot) {

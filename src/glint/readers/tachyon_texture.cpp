@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "glint/core/bounds.h"
+
 namespace glint::tachyon {
 
 std::string upper(std::string_view text) {
@@ -124,16 +126,30 @@ Number constant(std::string_view text, double value, const TextPosition& at) {
 
 }  // namespace
 
+// A texture's number within [lo, hi] (Tachyon itself takes anything; glint's materials are
+// non-negative, DESIGN.md §7); else an error at it.
+void Textures::requireRange(const Number& n, double lo, double hi, std::string_view what) {
+  if (n.value >= lo && n.value <= hi) return;
+  out_.error(n.at, hi == kInfinity ? fmt::format("{} must be >= {:g}, got {}", what, lo, n.text)
+                                   : fmt::format("{} must be between {:g} and {:g}, got {}", what,
+                                                 lo, hi, n.text));
+  throw SyntaxError{};
+}
+
 Texture Textures::body(const Token& statement, bool vertexColors) {
   Texture t;
   in_.keyword(statement, "AMBIENT");
   t.ambient = in_.number(statement, "ambient");
+  requireRange(t.ambient, 0, kInfinity, "AMBIENT");
   in_.keyword(statement, "DIFFUSE");
   t.diffuse = in_.number(statement, "diffuse");
+  requireRange(t.diffuse, 0, kInfinity, "DIFFUSE");
   in_.keyword(statement, "SPECULAR");
   t.specular = in_.number(statement, "specular (mirror reflection)");
+  requireRange(t.specular, 0, kInfinity, "SPECULAR");
   in_.keyword(statement, "OPACITY");
   t.opacity = in_.number(statement, "opacity");
+  requireRange(t.opacity, 0, 1, "OPACITY");
   t.phong = constant("0", 0, t.diffuse.at);
   t.phongSize = constant("100", 100, t.diffuse.at);
   Token next = in_.need(statement, "COLOR");
@@ -155,10 +171,17 @@ Texture Textures::body(const Token& statement, bool vertexColors) {
   }
   if (upper(next.text) == "PHONG") {
     const Token kind = in_.need(statement, "PLASTIC or METAL");
+    if (upper(kind.text) != "PLASTIC" && upper(kind.text) != "METAL") {
+      out_.error(kind.at, fmt::format("PHONG: expected PLASTIC or METAL, got {}",
+                                      quoteForMessage(kind.text)));
+      throw SyntaxError{};
+    }
     t.metal = upper(kind.text) == "METAL";
     t.phong = in_.number(statement, "phong");
+    requireRange(t.phong, 0, kInfinity, "PHONG");
     in_.keyword(statement, "PHONG_SIZE");
     t.phongSize = in_.number(statement, "phong size");
+    requireRange(t.phongSize, 0, kInfinity, "PHONG_SIZE");
     next = in_.need(statement, "COLOR");
   }
   if (vertexColors) {
@@ -167,7 +190,10 @@ Texture Textures::body(const Token& statement, bool vertexColors) {
     return t;
   }
   in_.expectWord(statement, next, "COLOR");
-  for (Number& c : t.color) c = in_.number(statement, "color");
+  for (Number& c : t.color) {
+    c = in_.number(statement, "color");
+    requireRange(c, 0, kInfinity, "COLOR");
+  }
   in_.keyword(statement, "TEXFUNC");
   const Number f = in_.number(statement, "texture function");
   if (f.value == 0) return t;
@@ -308,7 +334,12 @@ void Textures::define(const std::string& name, const Texture& texture, const Tex
                       bool transVmd) {
   (void)at;
   std::string material = name;
-  for (int k = 2; materialNames_.count(material) > 0; ++k) material = fmt::format("{}_{}", name, k);
+  if (materialNames_.count(material) > 0) {
+    int& k = nextSuffix_.try_emplace(name, 2).first->second;
+    do {
+      material = fmt::format("{}_{}", name, k++);
+    } while (materialNames_.count(material) > 0);
+  }
   emitMaterial(texture, transVmd, material);
   named_[name] = material;
   definitions_[name] = texture;

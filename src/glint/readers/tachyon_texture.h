@@ -98,7 +98,12 @@ class Textures {
   std::map<std::string, std::string> named_;     // TEXDEF and TEXALIAS names → material names
   std::map<std::string, std::string> byValues_;  // a material's values → its name
   std::map<std::string, Texture> definitions_;   // TEXDEF name → its texture (vertex colours)
-  std::set<std::string> materialNames_;          // every material emitted
+  void requireRange(const Number& n, double lo, double hi, std::string_view what);
+
+  std::set<std::string> materialNames_;  // every material emitted
+  // Per TEXDEF name defined again, the suffix to try next (name_2, name_3...): names are never
+  // freed, so every smaller suffix is taken and a redefinition costs no search from 2.
+  std::map<std::string, int> nextSuffix_;
   std::size_t generated_ = 0;
 };
 

@@ -197,9 +197,31 @@ SceneDescription sceneWithFile(const std::string& name, const std::filesystem::p
   return scene;
 }
 
+// A NUL byte is no text: refused at its place (it would otherwise read as a blank, joining or
+// splitting the words around it without a word said).
+void refuseNulByte(std::string_view text, const std::string& file) {
+  const std::size_t at = text.find('\0');
+  if (at == std::string_view::npos) return;
+  int line = 1;
+  int column = 1;
+  for (std::size_t i = text.starts_with("\xEF\xBB\xBF") ? 3 : 0; i < at; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c == '\n') {
+      ++line;
+      column = 1;
+    } else if ((c & 0xC0) != 0x80) {
+      ++column;
+    }
+  }
+  throw SceneError({{Diagnostic::Severity::Error,
+                     {file, line, column},
+                     "the file holds a NUL byte here; a scene file is text"}});
+}
+
 ParseResult parseSceneText(std::string_view text, const std::string& file,
                            const std::filesystem::path& baseDirectory,
                            const std::atomic<bool>* cancel, StatementReader read) {
+  refuseNulByte(text, file);
   SceneDescription scene = sceneWithFile(file, baseDirectory);
   scene.files[0]->bytes = text.size();
   scene.files[0]->values.reserveForText(text.size());  // as the YAML reader: no regrowth
@@ -212,6 +234,7 @@ ParseResult readSceneTextFile(const std::filesystem::path& path, const std::stri
   if (base.empty()) base = ".";
   SceneDescription scene = sceneWithFile(name, base);
   const std::string text = readWholeSceneFile(path, name, *scene.files[0]);
+  refuseNulByte(text, name);
   scene.files[0]->values.reserveForText(text.size());  // as the YAML reader: no regrowth
   return read(text, std::move(scene), cancel);
 }

@@ -29,7 +29,9 @@ struct Token {
 // Places are 1-based lines and columns counted in characters (UTF-8), as the YAML reader counts.
 class Tokenizer {
  public:
-  explicit Tokenizer(std::string_view text) : text_(text) {}
+  // A UTF-8 byte-order mark at the start is skipped (an editor's, invisible: columns from 1).
+  explicit Tokenizer(std::string_view text)
+      : text_(text), pos_(text.starts_with("\xEF\xBB\xBF") ? 3 : 0) {}
   // The next token, or nullopt at the end.
   std::optional<Token> next();
   std::optional<Token> peek();
