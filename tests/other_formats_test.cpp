@@ -4,6 +4,7 @@
 // and spot falloff cones; then `glint convert` (the converted YAML renders the same bytes, with and
 // without PLY files) and the quick look at a mesh file.
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -12,10 +13,12 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <set>
 #include <string>
 
 #include "glint/factories/quick_look.h"
 #include "glint/factories/scene_loader.h"
+#include "glint/job/job_error.h"
 #include "glint/job/scene_convert.h"
 #include "glint/readers/nff_reader.h"
 #include "glint/readers/tachyon_reader.h"
@@ -299,6 +302,22 @@ TEST_F(Convert, LargePolygonSetsGoToPlyFilesAndRenderTheSameBytes) {
     }
   }
   expectSameImage(write("grid.nff", nff), 2);
+  // Every file or none: a folder where the second mesh file would go fails the convert before
+  // anything is written (the first mesh file was left behind).
+  const fs::path output = folder_ / "blocked" / "grid.yaml";
+  fs::create_directories(folder_ / "blocked" / "grid_mesh2.ply");
+  try {
+    convertScene(ConvertSpec{folder_ / "grid.nff", output, nullptr});
+    ADD_FAILURE() << "not refused";
+  } catch (const JobError& e) {
+    EXPECT_EQ(e.exitCode(), 1);
+    EXPECT_THAT(e.what(), testing::HasSubstr("grid_mesh2.ply: cannot write: it is a folder"));
+  }
+  std::set<std::string> left;
+  for (const auto& entry : fs::directory_iterator(folder_ / "blocked")) {
+    left.insert(entry.path().filename().string());
+  }
+  EXPECT_EQ(left, std::set<std::string>{"grid_mesh2.ply"});
 }
 
 TEST_F(Convert, TexturesAndTheirImageFilesKeepTheirPaths) {

@@ -1,7 +1,11 @@
 #include "glint/job/scene_convert.h"
 
 #include <cerrno>
+#include <memory>
+#include <string>
 #include <system_error>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -41,15 +45,33 @@ void checkOutput(const fs::path& output, const fs::path& scene) {
   }
 }
 
-void writeAtomically(const fs::path& target, const std::string& bytes) {
+// Writes every file (the meshes, then the scene) or none: each is written whole to a temporary
+// file first, and only when all are complete are they renamed over their targets. A target that
+// is a folder is refused before anything is written (the rename would fail after the others).
+void writeAllOrNothing(const std::vector<std::pair<fs::path, const std::string*>>& files) {
+  std::vector<std::unique_ptr<AtomicFile>> written;
+  for (const auto& [target, bytes] : files) {
+    std::error_code error;
+    if (fs::is_directory(target, error)) {
+      throw JobError(JobFailure::Failure,
+                     fmt::format("{}: cannot write: it is a folder", target.string()));
+    }
+  }
+  const fs::path* current = nullptr;
   try {
-    AtomicFile file(target);
-    file.write(bytes);
-    file.close(true);
-    file.commit();
+    for (const auto& [target, bytes] : files) {
+      current = &target;
+      written.push_back(std::make_unique<AtomicFile>(target));
+      written.back()->write(*bytes);
+      written.back()->close(true);
+    }
+    for (const std::unique_ptr<AtomicFile>& file : written) {
+      current = &file->target();
+      file->commit();
+    }
   } catch (const std::system_error& e) {
     throw JobError(JobFailure::Failure,
-                   fmt::format("{}: cannot write: {}", target.string(), e.code().message()));
+                   fmt::format("{}: cannot write: {}", current->string(), e.code().message()));
   }
 }
 
@@ -75,12 +97,13 @@ ConvertResult convertScene(const ConvertSpec& spec) {
   write.sourceName = spec.scene.filename().string();
   const WrittenScene written = writeSceneYaml(parsed.description, result.output, write);
   fs::path folder = result.output.parent_path();
+  std::vector<std::pair<fs::path, const std::string*>> files;
   for (const WrittenScene::File& file : written.files) {
-    const fs::path path = folder / file.name;
-    writeAtomically(path, file.bytes);
-    result.meshFiles.push_back(path);
+    files.emplace_back(folder / file.name, &file.bytes);
   }
-  writeAtomically(result.output, written.yaml);
+  files.emplace_back(result.output, &written.yaml);
+  writeAllOrNothing(files);
+  for (std::size_t i = 0; i + 1 < files.size(); ++i) result.meshFiles.push_back(files[i].first);
   return result;
 }
 
