@@ -1,5 +1,6 @@
 #include "glint/readers/diagnostics.h"
 
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -10,33 +11,53 @@ namespace glint {
 
 namespace {
 
+// Bytes of the well-formed UTF-8 sequence starting at text[i] (1 for ASCII), or 0 when it is not
+// one (a stray continuation byte, a cut or overlong sequence, a surrogate, past U+10FFFF).
+std::size_t utf8Width(std::string_view text, std::size_t i) {
+  const auto c = static_cast<unsigned char>(text[i]);
+  if (c < 0x80) return 1;
+  const std::size_t width = (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+  if (width == 0 || i + width > text.size()) return 0;
+  std::uint32_t code = c & (0x7Fu >> width);
+  for (std::size_t k = 1; k < width; ++k) {
+    const auto next = static_cast<unsigned char>(text[i + k]);
+    if ((next & 0xC0) != 0x80) return 0;
+    code = (code << 6) | (next & 0x3Fu);
+  }
+  constexpr std::uint32_t kLeast[] = {0, 0, 0x80, 0x800, 0x10000};
+  if (code < kLeast[width] || (code >= 0xD800 && code <= 0xDFFF) || code > 0x10FFFF) return 0;
+  return width;
+}
+
+// Control characters, C1 controls and bytes that are not UTF-8 as escapes (a message is UTF-8
+// text, and a terminal must not take a byte of the file for a command).
 std::string escaped(std::string_view text, std::size_t maxCharacters) {
   std::string out;
   std::size_t characters = 0;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    const bool continuation = (c & 0xC0) == 0x80;
-    if (!continuation && characters == maxCharacters) {
+  for (std::size_t i = 0; i < text.size();) {
+    if (characters == maxCharacters) {
       out += "...";
       break;
     }
-    if (!continuation) ++characters;
+    ++characters;
+    const auto c = static_cast<unsigned char>(text[i]);
+    const std::size_t width = utf8Width(text, i);
     if (c == '\n') {
       out += "\\n";
     } else if (c == '\t') {
       out += "\\t";
     } else if (c == '\r') {
       out += "\\r";
-    } else if (c < 0x20 || c == 0x7F) {
+    } else if (width == 0 || c < 0x20 || c == 0x7F) {
       out += fmt::format("\\x{:02x}", c);
-    } else if (c == 0xC2 && i + 1 < text.size() &&
-               (static_cast<unsigned char>(text[i + 1]) & 0xE0) == 0x80) {
+    } else if (c == 0xC2 && (static_cast<unsigned char>(text[i + 1]) & 0xE0) == 0x80) {
       // U+0080..U+009F, the C1 controls (0x9B starts a terminal escape sequence on some
       // terminals).
-      out += fmt::format("\\u{:04x}", static_cast<unsigned char>(text[++i]));
+      out += fmt::format("\\u{:04x}", static_cast<unsigned char>(text[i + 1]));
     } else {
-      out += static_cast<char>(c);
+      out.append(text.substr(i, width));
     }
+    i += width == 0 ? 1 : width;
   }
   return out;
 }

@@ -132,10 +132,12 @@ class TachyonReader {
       shaderMode(t);
     } else if (word == "TEXDEF") {
       const Token name = in_.need(t, "a texture name");
+      requireTextureName(t, name);
       const Texture texture = textures_.body(t, false);
       textures_.define(std::string(name.text), texture, name.at, transVmd_);
     } else if (word == "TEXALIAS") {
       const Token alias = in_.need(t, "the alias name");
+      requireTextureName(t, alias);
       const Token original = in_.need(t, "the texture it names");
       textures_.alias(std::string(alias.text), original);
     } else if (word == "SPHERE" || word == "FCYLINDER" || word == "CYLINDER" || word == "RING" ||
@@ -317,6 +319,44 @@ class TachyonReader {
     } else {
       fog_ = f;
     }
+  }
+
+  // A texture name becomes a material name of the scene (and a YAML key when converted): at most
+  // 256 bytes of UTF-8 text without control characters. VMD writes short ASCII names.
+  void requireTextureName(const Token& statement, const Token& name) {
+    constexpr std::size_t kLongestName = 256;
+    const std::string_view text = name.text;
+    bool ok = text.size() <= kLongestName;
+    for (std::size_t i = 0; ok && i < text.size();) {
+      const auto c = static_cast<unsigned char>(text[i]);
+      std::size_t width = c < 0x80           ? 1
+                          : (c >> 5) == 0x6  ? 2
+                          : (c >> 4) == 0xE  ? 3
+                          : (c >> 3) == 0x1E ? 4
+                                             : 0;
+      if (width == 0 || i + width > text.size() || c < 0x20 || c == 0x7F) {
+        ok = false;
+        break;
+      }
+      std::uint32_t code = width == 1 ? c : c & (0x7F >> width);
+      for (std::size_t k = 1; k < width; ++k) {
+        const auto next = static_cast<unsigned char>(text[i + k]);
+        if ((next & 0xC0) != 0x80) ok = false;
+        code = (code << 6) | (next & 0x3F);
+      }
+      // Overlong forms, surrogates, past U+10FFFF and the C1 controls (U+0080..U+009F).
+      const std::uint32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
+      if (code < least[width] || (code >= 0xD800 && code <= 0xDFFF) || code > 0x10FFFF ||
+          (code >= 0x80 && code <= 0x9F)) {
+        ok = false;
+      }
+      i += width;
+    }
+    if (ok) return;
+    out_.error(name.at, fmt::format("{}: a texture name must be UTF-8 text of at most {} bytes "
+                                    "without control characters, got {}",
+                                    statement.text, kLongestName, quoteForMessage(text)));
+    throw SyntaxError{};
   }
 
   // --- lights --------------------------------------------------------------------------------

@@ -284,6 +284,23 @@ TEST(TachyonReader, UnsupportedStatementsNameTheNearestSupportedOne) {
   // only (the edit distance is quadratic: 4 MB of 'Q' took 5.6 s and 624 MB).
   EXPECT_EQ(error(std::string(1 << 20, 'Q')).substr(0, 40),
             "bad.dat:2:1: unknown Tachyon statement '");
+  // A texture name becomes a material name (a YAML key when converted): printable UTF-8 only.
+  const std::string body = " AMBIENT 0 DIFFUSE 1 SPECULAR 0 OPACITY 1 COLOR 1 0 0 TEXFUNC 0";
+  const std::string nameRule =
+      ": a texture name must be UTF-8 text of at most 256 bytes without control characters, got ";
+  EXPECT_EQ(error("TEXDEF r\xE9"
+                  "d" +
+                  body),
+            "bad.dat:2:8: TEXDEF" + nameRule + "'r\\xe9d'");
+  EXPECT_EQ(error("TEXDEF a\x7F" + body), "bad.dat:2:8: TEXDEF" + nameRule + "'a\\x7f'");
+  EXPECT_EQ(error("TEXDEF a\xC2\x85" + body), "bad.dat:2:8: TEXDEF" + nameRule + "'a\\u0085'");
+  EXPECT_THAT(error("TEXDEF " + std::string(257, 'a') + body), HasSubstr(nameRule));
+  EXPECT_EQ(error("TEXDEF r\xC3\xB8"
+                  "d" +
+                  body +
+                  "\nTEXALIAS x\x01 r\xC3\xB8"
+                  "d"),
+            "bad.dat:3:10: TEXALIAS" + nameRule + "'x\\x01'");
   EXPECT_EQ(firstError(parseTachyon("RESOLUTION 8 8", "a.dat")),
             "a.dat:1:1: expected BEGIN_SCENE, got 'RESOLUTION'; a Tachyon scene starts with "
             "BEGIN_SCENE and RESOLUTION");
