@@ -107,8 +107,13 @@ Cone Cone::make(const Point3& base, double baseRadius, const Point3& apex, doubl
   if (!(height >
         kCollinearTolerance * std::max({baseRadius, apexRadius, maxComponent(abs(axis))})) ||
       !std::isfinite(height)) {
-    throw ShapeError("apex",
-                     fmt::format("apex must differ from base, got {} for both", format(apex)));
+    throw ShapeError(
+        "apex", base == apex
+                    ? fmt::format("apex must differ from base, got {} for both", format(apex))
+                    : fmt::format("apex is {:g} from base, too short for radii {:g} and {:g} (the "
+                                  "cone would be a flat ring; its height must exceed 1e-12 of its "
+                                  "radius)",
+                                  height, baseRadius, apexRadius));
   }
   return Cone{base, axis / height, height, baseRadius, apexRadius};
 }

@@ -127,6 +127,11 @@ TEST(ShapeCone, MakeRejectsDegenerateInput) {
                 return Cone::make({0, 0, 0}, 1, {0, 0, 0}, 1);
               }),
               HasSubstr("apex: apex must differ from base"));
+  // Apart, but too short for its radii: said so, not that the two points are one.
+  EXPECT_THAT(errorOf([] {
+                return Cone::make({0, 0, 0}, 1e12, {0, 0, 1}, 1e12);
+              }),
+              HasSubstr("apex: apex is 1 from base, too short for radii 1e+12 and 1e+12"));
   EXPECT_THAT(errorOf([] {
                 return Cone::make({0, 0, 0}, -1, {0, 0, 1}, 1);
               }),
