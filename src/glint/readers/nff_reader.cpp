@@ -91,6 +91,12 @@ class NffReader {
       cone(t);
     } else if (s == "p" || s == "pp") {
       polygon(t, s == "pp");
+    } else if (!t.lineStart) {
+      // Each statement takes a fixed count of numbers: a word left on its line is one too many.
+      out_.error(t.at, fmt::format("unexpected {} after the statement's values on this line (one "
+                                   "value too many?)",
+                                   quoteForMessage(s)));
+      throw SyntaxError{};
     } else {
       const std::string nearest = nearestName(s, kStatements);
       out_.error(t.at,

@@ -206,6 +206,10 @@ TEST(NffReader, ErrorsNameTheirLineAndColumn) {
             "bad.nff:2:1: unknown NFF statement 'pq' (did you mean 'p'?); the statements are v, "
             "b, l, f, c, s, p, pp and # comments");
   EXPECT_EQ(error("s 0 0 x 1\n"), "bad.nff:2:7: s: expected a number (center z), got 'x'");
+  // A value too many is named on its own line (it was 'unknown NFF statement '7'').
+  EXPECT_EQ(error("s 0 0 0 1 7\n"),
+            "bad.nff:2:11: unexpected '7' after the statement's values on this line (one value "
+            "too many?)");
   EXPECT_EQ(error("c 0 0 0 1 0 0 1\n"),
             "bad.nff:3:1: the file ends inside 'c' (line 2): expected a number (apex radius)");
   EXPECT_EQ(error("c 0 0 0 -1 0 0 1 1\n"),
