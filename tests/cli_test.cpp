@@ -308,6 +308,9 @@ TEST_F(Cli, ConvertWritesAYamlSceneThatRendersTheSameBytes) {
   r = run({"convert", scene, "-o", "balls.png"});
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "name it .yaml")) << r.err;
+  r = run({"convert", scene, "-o", "balls.json"});  // YAML's flow style is not JSON
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "is YAML (not JSON); name it .yaml or .yml")) << r.err;
   r = run({"convert", (kBroken / "nff_zero_radius.nff").string(), "-o", "zero.yaml"});
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "nff_zero_radius.nff:11:9:")) << r.err;

@@ -26,9 +26,10 @@ fs::path outputFor(const ConvertSpec& spec) {
 
 void checkOutput(const fs::path& output, const fs::path& scene) {
   const std::string extension = output.extension().string();
-  if (extension != ".yaml" && extension != ".yml" && extension != ".json") {
+  // The scene is written in YAML's flow style, which is not JSON: a .json name would mislead.
+  if (extension != ".yaml" && extension != ".yml") {
     throw JobError(JobFailure::BadInput,
-                   fmt::format("{}: the converted scene is YAML; name it .yaml (or .yml, .json)",
+                   fmt::format("{}: the converted scene is YAML (not JSON); name it .yaml or .yml",
                                output.string()));
   }
   fs::path folder = output.parent_path();
