@@ -206,6 +206,15 @@ TEST(NffReader, ErrorsNameTheirLineAndColumn) {
             "bad.nff:2:1: unknown NFF statement 'pq' (did you mean 'p'?); the statements are v, "
             "b, l, f, c, s, p, pp and # comments");
   EXPECT_EQ(error("s 0 0 x 1\n"), "bad.nff:2:7: s: expected a number (center z), got 'x'");
+  // Lines end at "\n", "\r\n" or a lone "\r" (classic Mac OS).
+  EXPECT_EQ(firstError(parseNff("v from 0 0 5 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 8 8"
+                                "\r# a comment\rs 0 0 x 1\r",
+                                "cr.nff")),
+            "cr.nff:3:7: s: expected a number (center z), got 'x'");
+  EXPECT_EQ(firstError(parseNff("v from 0 0 5 at 0 0 0 up 0 1 0 angle 45 hither 1 resolution 8 8"
+                                "\r\n# a comment\r\ns 0 0 x 1\r\n",
+                                "crlf.nff")),
+            "crlf.nff:3:7: s: expected a number (center z), got 'x'");
   // A value too many is named on its own line (it was 'unknown NFF statement '7'').
   EXPECT_EQ(error("s 0 0 0 1 7\n"),
             "bad.nff:2:11: unexpected '7' after the statement's values on this line (one value "

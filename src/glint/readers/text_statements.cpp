@@ -19,7 +19,8 @@ namespace glint {
 
 void Tokenizer::advance() {
   const auto c = static_cast<unsigned char>(text_[pos_++]);
-  if (c == '\n') {
+  // "\n", "\r\n" and a lone "\r" (classic Mac OS files) each end a line.
+  if (c == '\n' || (c == '\r' && (pos_ == text_.size() || text_[pos_] != '\n'))) {
     ++line_;
     column_ = 1;
     ++offset_;
@@ -37,7 +38,7 @@ void Tokenizer::skipSpaceAndComments() {
   while (pos_ < text_.size()) {
     const char c = text_[pos_];
     if (c == '#') {
-      while (pos_ < text_.size() && text_[pos_] != '\n') advance();
+      while (pos_ < text_.size() && text_[pos_] != '\n' && text_[pos_] != '\r') advance();
     } else if (std::isspace(static_cast<unsigned char>(c)) || c == '\0') {
       advance();
     } else {
@@ -206,7 +207,7 @@ void refuseNulByte(std::string_view text, const std::string& file) {
   int column = 1;
   for (std::size_t i = text.starts_with("\xEF\xBB\xBF") ? 3 : 0; i < at; ++i) {
     const auto c = static_cast<unsigned char>(text[i]);
-    if (c == '\n') {
+    if (c == '\n' || (c == '\r' && (i + 1 == text.size() || text[i + 1] != '\n'))) {
       ++line;
       column = 1;
     } else if ((c & 0xC0) != 0x80) {
