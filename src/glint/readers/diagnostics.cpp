@@ -9,10 +9,8 @@
 
 namespace glint {
 
-namespace {
+namespace {}  // namespace
 
-// Bytes of the well-formed UTF-8 sequence starting at text[i] (1 for ASCII), or 0 when it is not
-// one (a stray continuation byte, a cut or overlong sequence, a surrogate, past U+10FFFF).
 std::size_t utf8Width(std::string_view text, std::size_t i) {
   const auto c = static_cast<unsigned char>(text[i]);
   if (c < 0x80) return 1;
@@ -28,6 +26,8 @@ std::size_t utf8Width(std::string_view text, std::size_t i) {
   if (code < kLeast[width] || (code >= 0xD800 && code <= 0xDFFF) || code > 0x10FFFF) return 0;
   return width;
 }
+
+namespace {
 
 // Control characters, C1 controls and bytes that are not UTF-8 as escapes (a message is UTF-8
 // text, and a terminal must not take a byte of the file for a command).

@@ -38,6 +38,10 @@ std::string shortenForMessage(std::string_view text);
 std::string escapeForMessage(std::string_view text);
 std::string quoteForMessage(std::string_view text);
 
+// Bytes of the well-formed UTF-8 sequence starting at text[i] (1 for ASCII), or 0 when it is not
+// one (a stray continuation byte, a cut or overlong sequence, a surrogate, past U+10FFFF).
+std::size_t utf8Width(std::string_view text, std::size_t i);
+
 // Whether any of `diagnostics` is an error (not only warnings).
 bool hasErrors(const std::vector<Diagnostic>& diagnostics);
 

@@ -433,23 +433,30 @@ class NffReader {
     }
   }
 
-  // Ear clipping (Meisters 1975) of a planar polygon, projected onto the coordinate plane its
-  // normal (Newell's) is most perpendicular to. Triangles keep the polygon's vertex order. A
-  // polygon that clipping cannot finish (self-intersecting, repeated vertices) gets a fan for the
-  // rest.
+  // Newell's vector of the vertex loop: its direction the polygon's normal, its length twice the
+  // (signed, projected) area.
+  static Vec3 newellNormal(const std::vector<Point3>& p) {
+    Vec3 normal;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Point3& a = p[i];
+      const Point3& b = p[(i + 1) % p.size()];
+      normal +=
+          Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
+    }
+    return normal;
+  }
+
+  // The coordinate axis to drop to project onto the plane `normal` is most perpendicular to.
+  static int droppedAxis(const Vec3& normal) {
+    const Vec3 an = abs(normal);
+    return an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+  }
+
   // How many times the boundary winds around, from its turning angles in the coordinate plane its
   // Newell normal is most perpendicular to (1 for a simple polygon, 2 for a pentagram).
   static long windings(const std::vector<Point3>& p) {
     const std::size_t n = p.size();
-    Vec3 normal;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Point3& a = p[i];
-      const Point3& b = p[(i + 1) % n];
-      normal +=
-          Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
-    }
-    const Vec3 an = abs(normal);
-    const int drop = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+    const int drop = droppedAxis(newellNormal(p));
     double total = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const Point3& a = p[(i + n - 1) % n];
@@ -481,14 +488,10 @@ class NffReader {
   // The largest distance of a vertex from the polygon's plane (through its centroid, normal
   // Newell's), relative to the polygon's size (its bounding box diagonal); 0 without a normal.
   static double offPlane(const std::vector<Point3>& p) {
-    Vec3 normal;
+    const Vec3 normal = newellNormal(p);
     Vec3 centroid;
     Bounds3 box;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const Point3& a = p[i];
-      const Point3& b = p[(i + 1) % p.size()];
-      normal +=
-          Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
+    for (const Point3& a : p) {
       centroid += toVec(a);
       box = unite(box, a);
     }
@@ -501,22 +504,20 @@ class NffReader {
     return off / size;
   }
 
+  // Ear clipping (Meisters 1975) of a planar polygon, projected onto the coordinate plane its
+  // normal (Newell's) is most perpendicular to. Triangles keep the polygon's vertex order. A
+  // polygon that clipping cannot finish (self-intersecting, repeated vertices) gets a fan for the
+  // rest.
+  // `fanned`: set when the fan was needed.
   static std::vector<std::array<std::size_t, 3>> triangulate(const std::vector<Point3>& p,
                                                              const std::atomic<bool>* cancel,
                                                              bool& fanned) {
     const std::size_t n = p.size();
-    Vec3 normal;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Point3& a = p[i];
-      const Point3& b = p[(i + 1) % n];
-      normal +=
-          Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
-    }
+    const Vec3 normal = newellNormal(p);
     std::vector<std::array<std::size_t, 3>> out;
     if (!(length(normal) > 0)) return out;
     if (n == 3) return {{0, 1, 2}};
-    const Vec3 an = abs(normal);
-    const int drop = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+    const int drop = droppedAxis(normal);
     const double sign = normal[drop] > 0 ? 1 : -1;
     const auto u = [&](std::size_t i) { return p[i][(drop + 1) % 3]; };
     const auto w = [&](std::size_t i) { return p[i][(drop + 2) % 3]; };

@@ -328,28 +328,11 @@ class TachyonReader {
     const std::string_view text = name.text;
     bool ok = text.size() <= kLongestName;
     for (std::size_t i = 0; ok && i < text.size();) {
+      const std::size_t width = utf8Width(text, i);
       const auto c = static_cast<unsigned char>(text[i]);
-      std::size_t width = c < 0x80           ? 1
-                          : (c >> 5) == 0x6  ? 2
-                          : (c >> 4) == 0xE  ? 3
-                          : (c >> 3) == 0x1E ? 4
-                                             : 0;
-      if (width == 0 || i + width > text.size() || c < 0x20 || c == 0x7F) {
-        ok = false;
-        break;
-      }
-      std::uint32_t code = width == 1 ? c : c & (0x7F >> width);
-      for (std::size_t k = 1; k < width; ++k) {
-        const auto next = static_cast<unsigned char>(text[i + k]);
-        if ((next & 0xC0) != 0x80) ok = false;
-        code = (code << 6) | (next & 0x3F);
-      }
-      // Overlong forms, surrogates, past U+10FFFF and the C1 controls (U+0080..U+009F).
-      const std::uint32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
-      if (code < least[width] || (code >= 0xD800 && code <= 0xDFFF) || code > 0x10FFFF ||
-          (code >= 0x80 && code <= 0x9F)) {
-        ok = false;
-      }
+      // Not UTF-8, a C0 control or DEL, or a C1 control (U+0080..U+009F: 0xC2 0x80..0x9F).
+      ok = width > 0 && c >= 0x20 && c != 0x7F &&
+           !(c == 0xC2 && (static_cast<unsigned char>(text[i + 1]) & 0xE0) == 0x80);
       i += width;
     }
     if (ok) return;
