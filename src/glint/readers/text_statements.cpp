@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <system_error>
 #include <utility>
 
@@ -199,10 +200,12 @@ SceneDescription sceneWithFile(const std::string& name, const std::filesystem::p
 }
 
 // A NUL byte is no text: refused at its place (it would otherwise read as a blank, joining or
-// splitting the words around it without a word said).
-void refuseNulByte(std::string_view text, const std::string& file) {
+// splitting the words around it without a word said). The error, as the readers give theirs: in
+// the result's diagnostics, with a description marked incomplete.
+std::optional<ParseResult> refusedForNulByte(std::string_view text, SceneDescription& scene,
+                                             const std::string& file) {
   const std::size_t at = text.find('\0');
-  if (at == std::string_view::npos) return;
+  if (at == std::string_view::npos) return std::nullopt;
   int line = 1;
   int column = 1;
   for (std::size_t i = text.starts_with("\xEF\xBB\xBF") ? 3 : 0; i < at; ++i) {
@@ -214,16 +217,22 @@ void refuseNulByte(std::string_view text, const std::string& file) {
       ++column;
     }
   }
-  throw SceneError({{Diagnostic::Severity::Error,
-                     {file, line, column},
-                     "the file holds a NUL byte here; a scene file is text"}});
+  ParseResult result;
+  scene.complete = false;
+  result.description = std::move(scene);
+  result.diagnostics.push_back({Diagnostic::Severity::Error,
+                                {file, line, column},
+                                "the file holds a NUL byte here; a scene file is text"});
+  return result;
 }
 
 ParseResult parseSceneText(std::string_view text, const std::string& file,
                            const std::filesystem::path& baseDirectory,
                            const std::atomic<bool>* cancel, StatementReader read) {
-  refuseNulByte(text, file);
   SceneDescription scene = sceneWithFile(file, baseDirectory);
+  if (std::optional<ParseResult> refused = refusedForNulByte(text, scene, file)) {
+    return std::move(*refused);
+  }
   scene.files[0]->bytes = text.size();
   scene.files[0]->values.reserveForText(text.size());  // as the YAML reader: no regrowth
   return read(text, std::move(scene), cancel);
@@ -235,7 +244,9 @@ ParseResult readSceneTextFile(const std::filesystem::path& path, const std::stri
   if (base.empty()) base = ".";
   SceneDescription scene = sceneWithFile(name, base);
   const std::string text = readWholeSceneFile(path, name, *scene.files[0]);
-  refuseNulByte(text, name);
+  if (std::optional<ParseResult> refused = refusedForNulByte(text, scene, name)) {
+    return std::move(*refused);
+  }
   scene.files[0]->values.reserveForText(text.size());  // as the YAML reader: no regrowth
   return read(text, std::move(scene), cancel);
 }
