@@ -302,6 +302,30 @@ TEST(InstancingErrors, AreReportedAtTheirPlace) {
                      "groups: {chair: []}\nobjects:\n  - {type: instance, group: chair, "
                      "transform: [{scale: 0}]}\n",
                  5, 56, "instance.transform[0].scale factors must be non-zero");
+  // As a placed object's: the transform invertible in double precision and the placed group
+  // within ±1e100 of the origin (a scale of 1e150 rendered nothing, without a word).
+  const std::string ball =
+      "groups:\n  ball: [{type: sphere, center: [0, 0, 0], radius: 1}, {type: plane, point: [0, "
+      "-1, 0], normal: [0, 1, 0]}]\nobjects:\n  - {type: instance, group: ball, transform: ";
+  expectOneError(base + ball + "[{scale: 1e150}]}\n", 6, 46,
+                 "instance.transform: transform must be invertible, got determinant inf");
+  expectOneError(base + ball + "[{scale: 1e-300}]}\n", 6, 46,
+                 "instance.transform: transform must be invertible, got determinant 0");
+  expectOneError(base + ball + "[{translate: [0, 0, -1e120]}]}\n", 6, 46,
+                 "instance.transform: the placed group reaches 1e+120 from the origin, beyond the "
+                 "±1e+100 glint computes in");
+}
+
+// An instance of an empty group (`chair:` or `chair: []`) shows nothing: said at its group.
+TEST(Instancing, AnInstanceOfAnEmptyGroupIsWarnedAbout) {
+  const LoadedScene loaded =
+      loadSceneFromString(std::string(testing::kMinimal) +
+                              "groups:\n  chair:\nobjects:\n  - {type: instance, group: chair}\n",
+                          "empty.yaml");
+  ASSERT_EQ(loaded.warnings.size(), 2u);  // and the scene's own "no lights"
+  EXPECT_EQ(loaded.warnings[1].format(),
+            "empty.yaml:6:29: warning: instance.group: the group 'chair' is empty, so this "
+            "instance shows nothing");
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "glint/factories/settings_factories.h"
 #include "glint/factories/texture_library.h"
 #include "glint/factories/transform_reader.h"
+#include "glint/geometry/object_space.h"
 #include "glint/geometry/surface_coordinates.h"
 #include "glint/mesh/mesh_loader.h"
 #include "glint/readers/spelling.h"
@@ -311,15 +312,49 @@ class Builder {
       return;
     }
     if (params.errors() != 0 || !transform.ok) return;
+    const Transform* worldFromGroup =
+        transform.worldFromObject ? &*transform.worldFromObject : nullptr;
+    const ValueId where =
+        params.has("transform") ? params.find("transform")->where : params.find("type")->where;
     try {
-      const Transform* worldFromGroup =
-          transform.worldFromObject ? &*transform.worldFromObject : nullptr;
+      // As a placed object's transform (Primitive): invertible, and the placed group within reach.
+      if (worldFromGroup != nullptr) requireInvertibleAffine(*worldFromGroup);
+      const Bounds3& local = groupBounds(it->second);
+      const double reach = reachOf(worldFromGroup ? (*worldFromGroup)(local) : local);
+      if (reach > kMaxCoordinate)
+        throw ShapeError("transform", "the placed group " + beyondReach(reach));
       parts_.instances.push_back(makeInstance(
           worldFromGroup, it->second, material.given ? material.index : kNoMaterialOverride));
+      const GroupParts& placed = parts_.groups[it->second];
+      if (placed.primitives.empty() && placed.meshes.empty()) {
+        sink_.warning(params.location(group->where),
+                      fmt::format("instance.group: the group '{}' is empty, so this instance "
+                                  "shows nothing",
+                                  escapeForMessage(group->value)));
+      }
     } catch (const std::invalid_argument& error) {
-      params.error(params.find("transform")->where,
-                   fmt::format("instance.transform: {}", error.what()));
+      params.error(where, fmt::format("instance.transform: {}", error.what()));
     }
+  }
+
+  // The bounds of group `g` in its own space (its bounded primitives' and its mesh vertices'),
+  // computed once.
+  const Bounds3& groupBounds(std::uint32_t g) {
+    if (groupBounds_.size() <= g) groupBounds_.resize(parts_.groups.size());
+    std::optional<Bounds3>& bounds = groupBounds_[g];
+    if (!bounds) {
+      Bounds3 b;
+      // Bounded content only: a plane reaches everywhere anyway, and its infinite box would hide
+      // how far the rest is carried.
+      for (const Primitive& p : parts_.groups[g].primitives) {
+        if (p.isBounded()) b = unite(b, p.bounds());
+      }
+      for (const TriangleMesh& mesh : parts_.groups[g].meshes) {
+        for (const Point3& q : mesh.positions) b = unite(b, q);
+      }
+      bounds = b;
+    }
+    return *bounds;
   }
 
   void buildObject(const Entity& e) { buildObject(e, fmt::format("objects[{}]", e.index)); }
@@ -782,6 +817,7 @@ class Builder {
   const ObjectFactory csgFactory_{"csg", kCsgKeys, nullptr};
   std::map<std::uint32_t, std::pair<std::uint32_t, TextPosition>> materialWhere_;  // file, place
   std::map<std::string, std::uint32_t, std::less<>> groupIndex_;    // into parts_.groups
+  std::vector<std::optional<Bounds3>> groupBounds_;                 // groupBounds()
   std::vector<std::pair<std::uint32_t, TextPosition>> groupWhere_;  // per group: file, place
   GroupParts* group_ = nullptr;  // while building a group's objects: where they go
   MeshCache meshCache_;          // each mesh file read once per scene
