@@ -193,6 +193,14 @@ TEST(ImageDecoder, HeadersRefuseWhatIsNotAnImage) {
   EXPECT_THROW(header("GIF89a....."), ImageReadError);
   EXPECT_THROW(header("\x89PNG\r\n\x1a\n"), ImageReadError);          // no IHDR
   EXPECT_THROW(header("#?RADIANCE\n\n+X 4 -Y 4\n"), ImageReadError);  // an unusual orientation
+  // A negative size is malformed, not 2^64 − 5 pixels past the texture limit.
+  try {
+    header("#?RADIANCE\n\n-Y -5 +X 10\n");
+    ADD_FAILURE() << "a negative height was accepted";
+  } catch (const ImageReadError& e) {
+    EXPECT_NE(std::string(e.what()).find("sizes in digits"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(header("#?RADIANCE\n\n-Y 5 +X -10\n"), ImageReadError);
   try {
     header("#?RADIANCE\n\n-Y 100000 +X 100000\n");
     ADD_FAILURE() << "a 10-gigapixel image was accepted";

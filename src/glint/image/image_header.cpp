@@ -145,8 +145,16 @@ ImageHeader hdrHeader(std::span<const std::uint8_t> b, std::size_t* pixelsStart 
   unsigned long height = 0;
   unsigned long width = 0;
   char tail = 0;
-  if (std::sscanf(line.c_str(), "-Y %lu +X %lu%c", &height, &width, &tail) != 2) {
-    malformed("HDR", "only the standard orientation '-Y height +X width' is read");
+  // %lu alone would take "-5" (as 2^64 − 5): the sizes must start with a digit.
+  const std::size_t widthAt = line.find("+X ");
+  const auto digitAt = [&](std::size_t i) {
+    return i < line.size() && line[i] >= '0' && line[i] <= '9';
+  };
+  if (std::sscanf(line.c_str(), "-Y %lu +X %lu%c", &height, &width, &tail) != 2 || !digitAt(3) ||
+      widthAt == std::string::npos || !digitAt(widthAt + 3)) {
+    malformed("HDR",
+              "the resolution line is not '-Y height +X width' (the standard "
+              "orientation, sizes in digits)");
   }
   checkSize(h, width, height);
   if (pixelsStart != nullptr) *pixelsStart = end + 1;
