@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "glint/readers/parameter_dictionary.h"
 #include "glint/readers/source_file.h"
@@ -230,8 +231,8 @@ class TopLevel {
     const ValueId root = document.root;
     if (file.values.isNull(root)) return;  // an empty file includes nothing
     if (!file.values.isMap(root)) {
-      sink_.error({name, 1, 1}, fmt::format("an included file must be a mapping of materials, "
-                                            "got {}",
+      sink_.error({name, 1, 1}, fmt::format("an included file must be a mapping (of {}), got {}",
+                                            fmt::join(kIncludedKeys, ", "),
                                             ValueReader(file.source(), sink_).describe(root)));
       return;
     }

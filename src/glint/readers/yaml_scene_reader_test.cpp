@@ -887,8 +887,8 @@ TEST_F(IncludeFiles, CyclesMissingFilesAndSceneKeysAreErrorsAtTheirPlace) {
   ASSERT_EQ(errors.size(), 3u);
   EXPECT_EQ(errors[0], "c.yaml:1:35: include: expected a file name, got a mapping");
   EXPECT_EQ(errors[1],
-            "list.yaml:1:1: an included file must be a mapping of materials, got a "
-            "list of 1 item");
+            "list.yaml:1:1: an included file must be a mapping (of include, textures, "
+            "materials, groups), got a list of 1 item");
   EXPECT_THAT(errors[2], HasSubstr("broken.yaml:1:26: syntax error: a '[' is not closed"));
   // An included file of two documents: the error is at the second one's start, as in a scene.
   write("d.yaml", std::string("include: two.yaml\n") + kCameraImage);
