@@ -68,6 +68,22 @@ TEST(AmbientOcclusion, APlaneAloneIsUnchanged) {
   }
 }
 
+// A smooth coarse mesh with nothing near it keeps all its ambient light: the directions about its
+// tilted shading normals that fall below a face are folded back above it, not counted as blocked.
+TEST(AmbientOcclusion, ASmoothMeshAloneIsUnchanged) {
+  SceneParts parts = ambientPlaneParts(64, 1e9);
+  parts.primitives.clear();
+  parts.meshes.push_back(testing::smoothIcosahedron({0, 0, 0}, 8, 1));
+  const Film film = render(Scene(std::move(parts)));
+  std::size_t onMesh = 0;
+  for (const Color& c : film.pixels()) {
+    if (c == Color(0.2, 0.3, 0.4)) continue;  // the background beside it
+    ++onMesh;
+    EXPECT_EQ(c, Color(1, 1, 1));
+  }
+  EXPECT_GT(onMesh, 40u);
+}
+
 TEST(AmbientOcclusion, BesideASphereTheContactRingDarkensAsTheAnalyticValueSays) {
   constexpr double kRadius = 1;
   SceneParts parts = ambientPlaneParts(4096, 1e9);

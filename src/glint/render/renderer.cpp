@@ -308,12 +308,23 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
   return sum / static_cast<double>(count);
 }
 
+// The mirror image of a unit direction w in the plane of the geometric surface (unit normal n).
+// Where a smooth mesh's shading normal tilts away from the geometric one, part of the hemisphere
+// about the shading normal lies below the surface; a diffuse or glossy direction drawn there is
+// folded back above it. The lobes then keep all their energy: a diffuse convex object under a
+// uniform sky is kd × sky everywhere (the white furnace of DESIGN.md §10), where ending the path
+// (or, for ambient occlusion, calling the direction blocked) darkened coarse smooth meshes.
+inline Vec3 foldAboveSurface(const Vec3& w, const Normal3& n) {
+  return w - toVec(n) * (2 * dot(n, w));
+}
+
 // Ambient occlusion (DESIGN.md §10, Tachyon's): the fraction of the ambient light that reaches the
 // hit, as the mean transmittance (the shadow rays' T_L: glass lets it through in part) of rays in
 // cosine-weighted directions about the shading normal on the viewer's side (the side of the
 // geometric surface the ray came from), each travelling render.ambient_occlusion.distance. A
-// direction below the geometric surface (where ns ≠ n) is blocked by the surface itself. The rays
-// count as shadow rays (both are any-hit queries).
+// direction below the geometric surface (where ns ≠ n) is folded back above it
+// (foldAboveSurface), so that a smooth surface with nothing near it keeps all its ambient light.
+// The rays count as shadow rays (both are any-hit queries).
 [[gnu::noinline]] Color ambientVisibility(const TraceContext& ctx, SpawnOrigins& origins,
                                           const Normal3& n, const Normal3& ns, double nv,
                                           const MediumStack* media, const SampleStream& stream,
@@ -328,9 +339,12 @@ std::uint32_t areaLightSampleCount(const AreaLight& light, std::uint32_t blurSam
   const SobolDimension2D directions = stream.dimension(kOcclusionDimension);
   Color sum;
   for (std::uint32_t k = 0; k < count; ++k) {
-    const Vec3 w =
+    Vec3 w =
         sampleCosineHemisphere(axis, tangent, bitangent, directions.at(stream.subIndex(count, k)));
-    if (!(dot(n, w) * side > 0)) continue;
+    if (!(dot(n, w) * side > 0)) {
+      w = foldAboveSurface(w, n);
+      if (!(dot(n, w) * side > 0)) continue;
+    }
     ++ctx.counts.shadow;
     sum += media ? ctx.scene.transmittance(origins.spawn(w), occlusion.distance, *media)
                  : ctx.scene.transmittance(origins.spawn(w), occlusion.distance);
@@ -738,17 +752,29 @@ double brdfSampleWeight(const TraceContext& ctx, double brdfPdf, double lightPdf
 }
 
 // The diffuse and glossy part of the normalised Phong BRDF at one hit, and the density with which
-// the path's lobe choice draws a direction from those two lobes.
+// the path's lobe choice draws a direction from those two lobes. On a smooth surface (shading
+// normal ≠ geometric) both are folded (foldAboveSurface): at a direction above the geometric
+// surface, the lobe's value there plus its value at the direction's mirror image below it.
 struct PhongLobes {
   const Material& material;
   const Vec3& up;         // shading normal on the side the path arrived from
   const Vec3& reflected;  // mirror direction of the view ray
   double diffuseShare;    // probability of the diffuse lobe (its strength / all lobes')
   double glossyShare;     // probability of the Phong lobe
+  const Normal3& n;       // geometric normal
+  bool smooth;            // the shading normal differs from n
 
-  // f(wi)·cos θ and the density; zero below the shading surface.
+  // f(wi)·cos θ and the density, for wi above the geometric surface.
   Color weighted(const Vec3& wi, double& pdf) const {
     pdf = 0;
+    Color f = unfolded(wi, pdf);
+    if (smooth) f += unfolded(foldAboveSurface(wi, n), pdf);
+    return f;
+  }
+
+ private:
+  // The lobes' own f(wi)·cos θ, their density added to pdf; zero below the shading surface.
+  Color unfolded(const Vec3& wi, double& pdf) const {
     const double cosTheta = dot(up, wi);
     if (!(cosTheta > 0)) return Color();
     Color f;
@@ -942,7 +968,7 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
     const bool smooth = !(ns == n);
     const Vec3 reflected = mirrorDirection(v, n, ns, nv, nsv, smooth);
     const Vec3 up = toVec(ns) * side;
-    const PhongLobes lobes{material, up, reflected, diffuse / total, glossy / total};
+    const PhongLobes lobes{material, up, reflected, diffuse / total, glossy / total, n, smooth};
     const bool sampleLights =
         diffuse + glossy > 0 && ctx.lightSampling != PathLightSampling::BrdfOnly;
     if (ctx.environment != nullptr && sampleLights) {
@@ -973,7 +999,11 @@ Color tracePath(const TraceContext& ctx, const Ray& cameraRay, const SampleStrea
         factor = material.ks * ((material.shininess + 2) / (material.shininess + 1) * cosTheta *
                                 (total / glossy));
       }
-      if (!(dot(n, w) * side > 0)) break;  // below the geometric surface
+      if (!(dot(n, w) * side > 0)) {
+        // Below the geometric surface (only where the shading normal tilts): folded back above.
+        w = foldAboveSurface(w, n);
+        if (!(dot(n, w) * side > 0)) break;
+      }
       if (ctx.environment != nullptr || ctx.emitters != nullptr) lobes.weighted(w, brdfPdf);
       ++ctx.counts.indirect;
     } else if (pick < diffuse + glossy + mirror) {
