@@ -710,42 +710,85 @@ class Builder {
     return isBlack(emission) && isBlack(m.kd) && isBlack(m.ks) && isBlack(m.kr) && isBlack(m.kt);
   }
 
-  // Objects shade black without any light, ambient, emission or mirror/glass to show the
-  // background; that is almost always a forgotten `lights` or `ambient` section.
-  void warnIfUnlit() {
-    if (sink_.hasErrors() ||
-        (parts_.primitives.empty() && parts_.meshes.empty() && parts_.instances.empty()) ||
-        !parts_.lights.empty() || !isBlack(parts_.ambient)) {
-      return;
-    }
+  // Whether pred(emission, material index) holds for some object: a primitive, a csg's operand, a
+  // mesh, an instance's material, or an object of a placed group (each group looked at once).
+  template <class Pred>
+  bool anyObject(Pred pred) const {
     for (const Primitive& p : parts_.primitives) {
-      if (shows(p.emission(), p.materialIndex())) return;
+      if (pred(p.emission(), p.materialIndex())) return true;
       if (const Csg* csg = p.csg()) {
         for (const CsgOperand& o : csg->tree->operands) {
-          if (shows(o.emission, o.materialIndex)) return;
+          if (pred(o.emission, o.materialIndex)) return true;
         }
       }
     }
     for (const TriangleMesh& mesh : parts_.meshes) {
-      if (shows(mesh.emission, mesh.materialIndex)) return;
+      if (pred(mesh.emission, mesh.materialIndex)) return true;
     }
-    // Instanced objects (with the instances' materials or their own) count as well; each placed
-    // group is looked at once.
     std::vector<bool> placed(parts_.groups.size(), false);
     for (const Instance& instance : parts_.instances) {
-      if (instance.material != kNoMaterialOverride && shows(Color(), instance.material)) return;
+      if (instance.material != kNoMaterialOverride && pred(Color(), instance.material)) return true;
       placed[instance.group] = true;
     }
     for (std::size_t g = 0; g < parts_.groups.size(); ++g) {
       if (!placed[g]) continue;
       for (const Primitive& p : parts_.groups[g].primitives) {
-        if (shows(p.emission(), p.materialIndex())) return;
+        if (pred(p.emission(), p.materialIndex())) return true;
       }
       for (const TriangleMesh& mesh : parts_.groups[g].meshes) {
-        if (shows(mesh.emission, mesh.materialIndex)) return;
+        if (pred(mesh.emission, mesh.materialIndex)) return true;
       }
     }
-    sink_.warning({d_.files.at(0)->name, 1, 1},
+    return false;
+  }
+
+  // Whether every ray that misses sees black (no light from the background under `path`).
+  bool backgroundIsBlack() const {
+    const Environment& e = parts_.environment;
+    switch (e.kind) {
+      case BackgroundKind::Uniform:
+        return isBlack(parts_.background);
+      case BackgroundKind::Gradient:
+        return isBlack(e.zenith) && isBlack(e.horizon) && isBlack(e.nadir);
+      case BackgroundKind::Sky:
+        return isBlack(e.skyTop) && isBlack(e.skyBottom);
+      case BackgroundKind::Image:
+        return !(e.intensity > 0);
+    }
+    return false;
+  }
+
+  // Objects shade black without any light: under `whitted` no lights, ambient, emission or
+  // mirror/glass to show the background; under `path` (which adds no ambient light, and to which
+  // the background is a light) no lights, emission or background. Almost always a forgotten
+  // `lights` or `ambient` section, or a scene written for the other integrator.
+  void warnIfUnlit() {
+    if (sink_.hasErrors() ||
+        (parts_.primitives.empty() && parts_.meshes.empty() && parts_.instances.empty()) ||
+        !parts_.lights.empty()) {
+      return;
+    }
+    const SourceLocation scene{d_.files.at(0)->name, 1, 1};
+    if (parts_.render.integrator == Integrator::Path) {
+      if (!backgroundIsBlack() ||
+          anyObject([](const Color& emission, std::uint32_t) { return !isBlack(emission); })) {
+        return;
+      }
+      sink_.warning(scene, fmt::format("the scene has no lights, no emissive objects and a black "
+                                       "background: under the path integrator every object will "
+                                       "render black{}",
+                                       isBlack(parts_.ambient)
+                                           ? ""
+                                           : " (the path integrator adds no ambient light)"));
+      return;
+    }
+    if (!isBlack(parts_.ambient) ||
+        anyObject([this](const Color& emission, std::uint32_t material) {
+          return shows(emission, material);
+        })) {
+      return;
+    }
+    sink_.warning(scene,
                   "the scene has no lights, no ambient light and no emissive, reflective or "
                   "transparent objects: every object will render black");
   }

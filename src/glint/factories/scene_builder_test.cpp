@@ -1004,6 +1004,41 @@ TEST(SceneBuilder, MeshesCountForTheUnlitWarning) {
                   .warnings.empty());
 }
 
+// Under `path` the background is a light and the ambient light is not added: a lit background
+// (of any kind) or an emitter is enough, ambient light is not.
+TEST(SceneBuilder, TheUnlitWarningFollowsTheIntegrator) {
+  const auto warningsOf = [&](const std::string& extra, const std::string& otherObject = "") {
+    return loadSceneFromString(std::string(kMinimal) + "render: {integrator: path}\n" + extra +
+                                   "objects:\n  - {type: sphere, center: [0, 0, -5], radius: 1, "
+                                   "material: {kd: 0.5}}\n" +
+                                   otherObject,
+                               "t.yaml")
+        .warnings;
+  };
+  EXPECT_TRUE(warningsOf("background: [0.8, 0.8, 0.8]\n").empty());
+  EXPECT_TRUE(
+      warningsOf("background: {type: gradient, zenith: [0, 0, 1], horizon: [0, 0, 0]}\n").empty());
+  EXPECT_TRUE(warningsOf("background: {type: sky, top: [0, 0, 0], bottom: [0.1, 0, 0]}\n").empty());
+  EXPECT_TRUE(
+      warningsOf("lights: [{type: point, position: [0, 0, 0], color: [1, 1, 1]}]\n").empty());
+  const std::vector<Diagnostic> ambientOnly = warningsOf("ambient: {color: [1, 1, 1]}\n");
+  ASSERT_EQ(ambientOnly.size(), 1u);
+  EXPECT_EQ(ambientOnly[0].format(),
+            "t.yaml:1:1: warning: the scene has no lights, no emissive objects and a black "
+            "background: under the path integrator every object will render black (the path "
+            "integrator adds no ambient light)");
+  EXPECT_EQ(
+      warningsOf("background: {type: gradient, zenith: [0, 0, 0], horizon: [0, 0, 0]}\n").size(),
+      1u);
+  EXPECT_TRUE(warningsOf("background: [0, 0, 0]\n",
+                         "  - {type: sphere, center: [0, 3, -5], radius: 1, emission: [1, 1, 1]}\n")
+                  .empty());
+  // A mirror under a black background still shows only black under `path`.
+  EXPECT_EQ(warningsOf("", "  - {type: sphere, center: [0, 3, -5], radius: 1, material: {kr: 1}}\n")
+                .size(),
+            1u);
+}
+
 // The column (1-based) where `token` first starts in `line`.
 int columnOf(const std::string& line, const std::string& token) {
   const std::size_t at = line.find(token);
@@ -1318,6 +1353,15 @@ TEST(SceneBuilder, AmbientOcclusionAndIntegratorKeys) {
   ASSERT_EQ(aoOverridden.size(), 1U);
   EXPECT_THAT(aoOverridden[0].format(), HasSubstr("this render uses path (--integrator)"));
   EXPECT_EQ(warningsOf("{ambient_occlusion: {}, min_depth: 2}", toPath).size(), 1U);
+  // Russian roulette starting at or past max_depth is allowed (it never runs) but said.
+  const std::vector<Diagnostic> noRoulette =
+      warningsOf("{integrator: path, min_depth: 5, max_depth: 3}");
+  ASSERT_EQ(noRoulette.size(), 1U);
+  EXPECT_EQ(noRoulette[0].format(),
+            "t.yaml:3:28: warning: render.min_depth 5 is not below max_depth 3: every path ends "
+            "at max_depth before Russian roulette would start");
+  EXPECT_TRUE(warningsOf("{integrator: path, min_depth: 2, max_depth: 3}").empty());
+  EXPECT_TRUE(warningsOf("{integrator: path, max_depth: 2}").empty());  // min_depth not written
   EXPECT_EQ(build("{}").integrator, Integrator::Whitted);
   EXPECT_EQ(build("{}").minDepth, 3);
 }

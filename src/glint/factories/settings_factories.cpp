@@ -206,6 +206,14 @@ void buildRender(const SceneDescription& scene, const Entity& e, BuildContext& c
   };
   if (used == Integrator::Path) unusedOption("ambient_occlusion", "whitted");
   if (used == Integrator::Whitted) unusedOption("min_depth", "path");
+  // Allowed (it turns Russian roulette off), but more often a min_depth meant for a larger
+  // max_depth: said at the key.
+  if (used == Integrator::Path && p.has("min_depth") && render.minDepth >= render.maxDepth) {
+    ctx.sink.warning(p.location(p.keyPlace("min_depth")),
+                     fmt::format("render.min_depth {} is not below max_depth {}: every path ends "
+                                 "at max_depth before Russian roulette would start",
+                                 render.minDepth, render.maxDepth));
+  }
 }
 
 void buildAmbient(const SceneDescription& scene, const Entity& e, BuildContext& ctx) {
