@@ -137,5 +137,32 @@ TEST(ClusterProtocol, IdentityDifferenceNamesWhatDiffers) {
   EXPECT_NE(differs(other).find("protocol"), std::string::npos);
 }
 
+// A mesh file's materials (an MTL's Kd) reach the scene only as material values: two ranks whose
+// MTL files differ load meshes of different materials, and are told so.
+TEST(RankIdentity, TheMeshFingerprintCoversTheMaterialsMeshFilesBring) {
+  SceneParts parts;
+  parts.image.width = 4;
+  parts.image.height = 3;
+  parts.camera.position = Point3{0, 0, 5};
+  parts.camera.fovDegrees = 45;
+  TriangleMesh mesh;
+  mesh.positions = {Point3{0, 0, 0}, Point3{1, 0, 0}, Point3{0, 1, 0}};
+  mesh.indices = {0, 1, 2};
+  mesh.materialIndex = 1;
+  parts.meshes.push_back(mesh);
+  Material copper;
+  copper.kd = Color(0.56, 0.22, 0.09);
+  parts.materials.push_back(copper);
+  const Scene a{parts};
+  parts.materials[1].kd.g = 0.62;
+  const Scene b{parts};
+  EXPECT_NE(meshFingerprint(a), meshFingerprint(b));
+  EXPECT_EQ(meshFingerprint(a), meshFingerprint(Scene{[&] {
+              SceneParts same = parts;
+              same.materials[1].kd.g = 0.22;
+              return same;
+            }()}));
+}
+
 }  // namespace
 }  // namespace glint::cluster

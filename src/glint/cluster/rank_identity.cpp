@@ -35,7 +35,8 @@ std::uint64_t meshFingerprint(const Scene& scene) {
     hash =
         fnv1a64(std::string_view(reinterpret_cast<const char*>(emission), sizeof emission), hash);
   }
-  return hash;
+  // The materials too: an OBJ's MTL or a glTF's materials reach the scene only through them.
+  return fnv1a64(materialBytes(scene.materials()), hash);
 }
 
 RankIdentity identityOf(const std::filesystem::path& sceneFile, std::string_view sceneBytes,
@@ -73,8 +74,8 @@ std::optional<std::string> identityDifference(const RankIdentity& reference,
                        fileFacts(reference.sceneBytes, reference.sceneHash));
   if (other.meshCount != reference.meshCount || other.meshHash != reference.meshHash)
     return fmt::format(
-        "the meshes its scene loads differ from rank 0's ({} meshes, FNV-1a 64 {:016x}; rank 0: "
-        "{} meshes, {:016x})",
+        "the meshes its scene loads, or their materials, differ from rank 0's ({} meshes, "
+        "FNV-1a 64 {:016x}; rank 0: {} meshes, {:016x})",
         other.meshCount, other.meshHash, reference.meshCount, reference.meshHash);
   if (other.fingerprint != reference.fingerprint)
     return std::string(

@@ -15,7 +15,8 @@
 namespace glint::cluster {
 
 // FNV-1a 64 over the geometry of every mesh of `scene` (positions, normals, indices, material,
-// emission), in scene order: the part of renderFingerprint that comes from mesh files.
+// emission), in scene order, and every material's values: the part of renderFingerprint that comes
+// from mesh files (an OBJ's MTL included).
 std::uint64_t meshFingerprint(const Scene& scene);
 
 // The identity of rendering `scene`, loaded from `sceneFile` whose bytes are `sceneBytes`, with

@@ -143,6 +143,30 @@ CheckpointSettings checkpointSettingsFor(const Scene& scene, const PixelRegion& 
   return s;
 }
 
+std::string materialBytes(const std::vector<Material>& materials) {
+  Writer w;
+  w.u64(materials.size());
+  const auto color = [&](const Color& c) {
+    w.f64(c.r);
+    w.f64(c.g);
+    w.f64(c.b);
+  };
+  for (const Material& m : materials) {
+    color(m.kd);
+    color(m.ks);
+    w.f64(m.shininess);
+    color(m.kr);
+    color(m.kt);
+    color(m.ka);
+    w.f64(m.ior);
+    w.f64(m.reflectionBlur);
+    w.f64(m.refractionBlur);
+    w.i32(m.priority);
+    w.u32(m.textures);
+  }
+  return std::move(w.text());
+}
+
 std::uint64_t renderFingerprint(std::string_view sceneFileBytes, const Scene& scene,
                                 const CheckpointSettings& settings) {
   Writer w;
@@ -167,6 +191,9 @@ std::uint64_t renderFingerprint(std::string_view sceneFileBytes, const Scene& sc
     m.f64(mesh.emission.b);
     hash = fnv1a64(m.text(), hash);
   }
+  // Every material's values: those of mesh files (an OBJ's MTL, a glTF's materials) are not in the
+  // scene file's bytes.
+  hash = fnv1a64(materialBytes(scene.materials()), hash);
   // The pictures of image textures and of the background, read from files the scene only names
   // (each once; an untextured scene adds nothing).
   std::vector<const MipMap*> images;

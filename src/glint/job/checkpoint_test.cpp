@@ -196,7 +196,7 @@ TEST(Checkpoint, MismatchNamesTheSettingThatDiffers) {
   EXPECT_NE(scene->find("scene file"), std::string::npos) << *scene;
 }
 
-TEST(Checkpoint, FingerprintCoversSceneBytesMeshesAndEverySetting) {
+TEST(Checkpoint, FingerprintCoversSceneBytesMeshesMaterialsAndEverySetting) {
   SceneParts parts;
   parts.image.width = 40;
   parts.image.height = 30;
@@ -210,6 +210,14 @@ TEST(Checkpoint, FingerprintCoversSceneBytesMeshesAndEverySetting) {
   const Scene withMesh{parts};
   parts.meshes[0].positions[2].y = 1.5;
   const Scene movedMesh{parts};
+  // A material value that comes from a mesh file (an MTL's Kd) is not in the scene file's bytes.
+  Material fromMtl;
+  fromMtl.kd = Color(0.56, 0.22, 0.09);
+  parts.materials.push_back(fromMtl);
+  parts.meshes[0].materialIndex = 1;
+  const Scene copper{parts};
+  parts.materials[1].kd.g = 0.62;
+  const Scene green{parts};
 
   const CheckpointSettings s = sampleSettings();
   const std::uint64_t base = renderFingerprint("scene text", plain, s);
@@ -218,6 +226,7 @@ TEST(Checkpoint, FingerprintCoversSceneBytesMeshesAndEverySetting) {
   EXPECT_NE(base, renderFingerprint("scene text", withMesh, s));
   EXPECT_NE(renderFingerprint("scene text", withMesh, s),
             renderFingerprint("scene text", movedMesh, s));
+  EXPECT_NE(renderFingerprint("scene text", copper, s), renderFingerprint("scene text", green, s));
   const auto changed = [&](auto change) {
     CheckpointSettings t = s;
     change(t);
