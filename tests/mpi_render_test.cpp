@@ -210,6 +210,13 @@ TEST_F(Mpi, ARankWithAnotherSceneOrOptionsIsRefused) {
   EXPECT_EQ(result.status, 2) << result.err;
   EXPECT_TRUE(contains(result.err, "rank 2 on ")) << result.err;
   EXPECT_TRUE(contains(result.err, "samples per pixel 9, rank 0's has 4")) << result.err;
+
+  // With a preview, a refused job still exits at once (the preview stays only after a render).
+  result = runCommand(launcher(1) + glint({"a.yaml", "-o", "out.png", "--preview", "0"}) +
+                      std::vector<std::string>{":", "-np", "1"} +
+                      glint({"a.yaml", "-o", "out.png", "--samples", "9"}));
+  EXPECT_EQ(result.status, 2) << result.err;
+  EXPECT_FALSE(contains(result.err, "the preview stays")) << result.err;
 }
 
 // The heavy scene small enough to render in seconds.
@@ -300,6 +307,18 @@ TEST_F(Mpi, InterruptingMpirunSavesTheCheckpoint) {
                                                        "saved to 'run.ckpt'")))
       << result.err;
   EXPECT_EQ(filesIn(work_), (std::set<std::string>{"run.ckpt"}));
+}
+
+// A malformed GLINT_MPI_TIMEOUT is a bad request (exit 2), as a malformed GLINT_ISA is.
+TEST_F(Mpi, AMalformedTimeoutIsABadRequest) {
+  const RunResult result = finish(
+      startCommand(launcher(2) + glint(kShowcaseSmall + std::vector<std::string>{"-o", "out.png"}),
+                   {"GLINT_MPI_TIMEOUT=abc"}),
+      60s);
+  EXPECT_EQ(result.status, 2) << result.err;
+  EXPECT_TRUE(contains(result.err, "GLINT_MPI_TIMEOUT must be a number of seconds > 0, got 'abc'"))
+      << result.err;
+  EXPECT_FALSE(fs::exists(work_ / "out.png"));
 }
 
 TEST_F(Mpi, ARankThatStopsAnsweringFailsTheJobAfterTheTimeout) {

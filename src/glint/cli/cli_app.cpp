@@ -469,7 +469,7 @@ int renderAndReport(RenderJobSpec spec, const RenderArgs& args, SignalGuard& sig
     if (preview)
       preview->end(PreviewPhase::Failed,
                    *error.what() ? error.what() : "the scene has errors (see the terminal)",
-                   signals.cancelFlag());
+                   signals.cancelFlag(), error.failure() == JobFailure::BadInput);
     return status;
   }
   if (result.outcome == RenderJobResult::Outcome::Interrupted) {
@@ -499,7 +499,13 @@ int runRender(const RenderArgs& args, SignalGuard& signals) {
   // Under mpirun or srun: one frame over every rank (docs/distributed.md); rank 0 reports.
   if (cluster::launchedByMpi()) {
     if (spec.threads == 0) spec.threads = cluster::defaultThreadsPerRank();
-    cluster::ClusterRender ranks;
+    std::optional<cluster::ClusterRender> started;
+    try {
+      started.emplace();
+    } catch (const std::invalid_argument& error) {
+      throw CliError(kExitBadInput, error.what());  // a bad GLINT_MPI_TIMEOUT, as a bad GLINT_ISA
+    }
+    cluster::ClusterRender& ranks = *started;
     if (!ranks.coordinates()) return ranks.serve(spec);
     ranks.distribute(spec);
     const int status = renderAndReport(std::move(spec), args, signals,

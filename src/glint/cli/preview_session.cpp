@@ -98,11 +98,11 @@ void PreviewSession::attach(RenderJobEvents& events) {
   attachPreview(events, state_);
 }
 
-void PreviewSession::end(PreviewPhase phase, const std::string& text,
-                         const std::atomic<bool>& stop) {
+void PreviewSession::end(PreviewPhase phase, const std::string& text, const std::atomic<bool>& stop,
+                         bool refused) {
   using Clock = std::chrono::steady_clock;
   state_.ended(phase, text);
-  if (renderBegan_ && !stop && request_.lingerSeconds != 0.0) {
+  if (renderBegan_ && !refused && !stop && request_.lingerSeconds != 0.0) {
     const std::string until = request_.lingerSeconds
                                   ? fmt::format("for {:g} s", *request_.lingerSeconds)
                                   : std::string("until Ctrl-C");

@@ -47,9 +47,11 @@ class PreviewSession {
   // Hooks the preview to the job's events (after those already set).
   void attach(RenderJobEvents& events);
   // The render's outcome, shown on the page (`text`: the summary or the error). When rendering had
-  // begun and `stop` is not set, keeps serving until `stop` is set (Ctrl-C) or the linger time has
-  // passed; then stops the server.
-  void end(PreviewPhase phase, const std::string& text, const std::atomic<bool>& stop);
+  // begun, `stop` is not set and the job was not refused (`refused`: a bad scene or request, exit
+  // 2, found before any tile — under MPI a rank's refusal comes after the render step began), keeps
+  // serving until `stop` is set (Ctrl-C) or the linger time has passed; then stops the server.
+  void end(PreviewPhase phase, const std::string& text, const std::atomic<bool>& stop,
+           bool refused = false);
 
  private:
   PreviewRequest request_;

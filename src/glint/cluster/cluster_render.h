@@ -13,7 +13,8 @@ namespace glint::cluster {
 
 class ClusterRender {
  public:
-  // Starts MPI (Session). Throws std::runtime_error when it cannot.
+  // Starts MPI (Session). Throws std::invalid_argument for a bad GLINT_MPI_TIMEOUT,
+  // std::runtime_error when it cannot start.
   ClusterRender();
 
   bool coordinates() const { return session_.rank() == 0; }

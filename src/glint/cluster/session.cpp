@@ -20,8 +20,8 @@ LinkTiming timingFromEnvironment() {
     const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), seconds);
     if (error != std::errc{} || end != value.data() + value.size() || !(seconds > 0) ||
         seconds > 1e6)
-      throw std::runtime_error("GLINT_MPI_TIMEOUT must be a number of seconds > 0, got '" +
-                               std::string(value) + "'");
+      throw std::invalid_argument("GLINT_MPI_TIMEOUT must be a number of seconds > 0, got '" +
+                                  std::string(value) + "'");
     timing.timeout = std::chrono::milliseconds(static_cast<long long>(seconds * 1000));
     // Several heartbeats fit in any timeout, so one late heartbeat is no alarm.
     if (timing.heartbeat * 4 > timing.timeout) timing.heartbeat = timing.timeout / 4;
