@@ -36,6 +36,7 @@
 #include "glint/mesh/mesh_repair.h"
 #include "glint/mesh/obj_check.h"
 #include "glint/mesh/obj_fast_parse.h"
+#include "glint/mesh/ply_check.h"
 #include "glint/scene/scene_limits.h"
 
 namespace glint {
@@ -585,8 +586,41 @@ MeshFile importMeshWithAssimp(const std::filesystem::path& path, const std::stri
   return importScene(path, extension, rule, nullptr);
 }
 
+namespace {
+
+// Refuses a PLY file whose body disagrees with its header (ply_check.h), at its place.
+void checkPlyBody(const std::filesystem::path& path, const ReferencedFileRule& rule) {
+  std::optional<PlyFault> fault;
+  {
+    MeshFileAccess files(rule);
+    const ReadableFile file = files.openChecked(path.c_str());
+    struct stat status {};
+    if (file.fd < 0 || ::fstat(file.fd, &status) != 0 || status.st_size <= 0) return;
+    const auto size = static_cast<std::size_t>(status.st_size);
+    void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd, 0);
+    if (mapped == MAP_FAILED) return;  // assimp's words for it
+    try {
+      fault = findPlyFault(std::string_view(static_cast<const char*>(mapped), size));
+    } catch (...) {
+      ::munmap(mapped, size);
+      throw;
+    }
+    ::munmap(mapped, size);
+  }
+  if (!fault) return;
+  // In the reason's words, as meshErrorPlace reads them.
+  if (fault->line > 0) {
+    throw MeshLoadError(fmt::format("invalid file: line {}, column {}: {}", fault->line,
+                                    fault->column, fault->what));
+  }
+  throw MeshLoadError("invalid file: " + fault->what);
+}
+
+}  // namespace
+
 MeshFile importMesh(const std::filesystem::path& path, const std::string& extension,
                     const ReferencedFileRule& rule) {
+  if (extension == ".ply") checkPlyBody(path, rule);
   if (extension == ".obj" && !objFastPathDisabled()) {
     if (std::optional<MeshFile> file = importSimpleObj(path, rule)) return std::move(*file);
   }

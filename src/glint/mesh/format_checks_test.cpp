@@ -87,12 +87,18 @@ TEST(MeshFormatChecks, HeaderCountsTheFileCannotHoldAreRefusedBeforeReading) {
 TEST(MeshFormatChecks, PolygonsOfTooManyCornersAreRefusedBeforeTriangulation) {
   TempDir dir;
   // A fuzzing finding: assimp's ASCII PLY reader took 400000 as a face's corner count (for a
-  // uchar list; it makes it 400001 here) and read zeros past the end; triangulating that face
-  // would have taken minutes.
+  // uchar list) and read zeros past the end. The body check (ply_check.h) now refuses that line;
+  // a face that really has 20000 corners is refused before triangulating it would take minutes.
   EXPECT_THAT(reasonFor(dir.write("fuzz.ply",
                                   "ply\nformat ascii 1.0\nelement vertex 2\nproperty float y\n"
                                   "element face 1\nproperty list uchar int vertex_indices\n"
                                   "end_header\n400000 0")),
+              HasSubstr("line 8, column 8: more values than 'vertex' 1 of 2 holds"));
+  std::string star =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float y\nelement face 1\nproperty "
+      "list int int vertex_indices\nend_header\n0\n1\n20000";
+  for (int i = 0; i < 20000; ++i) star += i % 2 ? " 1" : " 0";
+  EXPECT_THAT(reasonFor(dir.write("star.ply", star + "\n")),
               HasSubstr("corners, more than the limit of 16384"));
   // A convex polygon of 2000 corners (a disc's cap) is read, as 1998 triangles.
   std::string disc =
@@ -115,7 +121,8 @@ TEST(MeshFormatChecks, CountsPastTheFilesEndFailForMemoryNotTime) {
 #else
   // A fuzzing finding: a uint8 list count of 44294967295, which assimp's ASCII PLY reader took
   // and filled with zeros read past the file's end (gigabytes, until the reader's 30 s limit).
-  // The reader's address space is capped by the file's size: refused at once.
+  // The reader's address space is capped by the file's size, and the body check refuses the count
+  // before assimp reads it: refused at once.
   TempDir dir;
   std::string cube =
       "ply\nformat ascii 1.0\nelement vertex 8\nproperty float32 x\nproperty float32 "
@@ -123,7 +130,10 @@ TEST(MeshFormatChecks, CountsPastTheFilesEndFailForMemoryNotTime) {
       "end_header\n0 0 0\n0 0 1\n0 1 1\n0 1 0\n1 0 0\n1 0 1\n1 1 1\n1 1 0\n";
   cube += "4 0 1 2 3\n4 7 6 5 4\n44294967295 0 4 5 1\n4 1 5 6 2\n4 2 6 7 3\n4 3 7 4 0\n";
   const auto start = std::chrono::steady_clock::now();
-  EXPECT_THAT(reasonFor(dir.write("counts.ply", cube)), HasSubstr("not enough memory to read it"));
+  // Now the body check's words, at the count's place.
+  EXPECT_THAT(
+      reasonFor(dir.write("counts.ply", cube)),
+      HasSubstr("line 20, column 1: '44294967295' is not a count of 'vertex_index' values"));
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
 #endif
 }
