@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -16,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "glint/mesh/assimp_import.h"
+#include "glint/mesh/format_checks.h"
 #include "glint/mesh/import_child.h"
 #include "glint/mesh/mesh_reader_wire.h"
 
@@ -58,21 +60,62 @@ namespace {
 #endif
 #endif
 
+// The bytes a .gltf brings: its own and those of the buffer files its `buffers` name (a data:
+// URI is inside it). A buffer that cannot be found adds nothing (assimp then fails on it).
+std::uintmax_t gltfBytes(const std::filesystem::path& file, std::uintmax_t own) {
+  std::string text;
+  {
+    std::FILE* in = std::fopen(file.c_str(), "rb");
+    if (in == nullptr) return own;
+    text.resize(static_cast<std::size_t>(own));
+    text.resize(std::fread(text.data(), 1, text.size(), in));
+    std::fclose(in);
+  }
+  std::uintmax_t total = own;
+  try {
+    const GltfJson json = parseGltfJson(text);
+    const ValueView buffers = json.root().find("buffers");
+    for (std::size_t i = 0; i < buffers.size(); ++i) {
+      const std::string_view uri = buffers[i].find("uri").scalar();
+      if (uri.empty() || uri.starts_with("data:")) continue;
+      // URIs are percent-encoded (RFC 3986).
+      std::string name;
+      for (std::size_t k = 0; k < uri.size(); ++k) {
+        if (uri[k] == '%' && k + 2 < uri.size() &&
+            std::isxdigit(static_cast<unsigned char>(uri[k + 1])) &&
+            std::isxdigit(static_cast<unsigned char>(uri[k + 2]))) {
+          name.push_back(
+              static_cast<char>(std::stoi(std::string(uri.substr(k + 1, 2)), nullptr, 16)));
+          k += 2;
+        } else {
+          name.push_back(uri[k]);
+        }
+      }
+      std::error_code error;
+      const std::uintmax_t size = std::filesystem::file_size(file.parent_path() / name, error);
+      if (!error) total += size;
+    }
+  } catch (const std::exception&) {
+    // Not JSON: assimp's words for it.
+  }
+  return total;
+}
+
 // Caps this process's address space at what it uses now plus 512 MiB plus 256 bytes per byte of
-// the mesh file. assimp's ASCII PLY reader takes any list count and reads zeros past the file's
-// end: a 383-byte file's count of 44294967295 had it fill gigabytes for the whole 30 s limit. With
-// the cap such a file fails in a fraction of a second (std::bad_alloc, "not enough memory");
-// real files need far less (a 100 MB binary PLY, 25 GB allowed). Not under AddressSanitizer,
-// whose shadow memory reserves terabytes of address space (the fuzzers bound the reader's time
-// instead: setMeshReadTimeLimitForTesting), and not for a .gltf, whose buffers are other files
-// of any size (a .glb holds its own).
+// the mesh file (for a .gltf, of it and its buffer files). assimp's ASCII PLY reader takes any
+// list count and reads zeros past the file's end: a 383-byte file's count of 44294967295 had it
+// fill gigabytes for the whole 30 s limit; a 577-byte .gltf whose sparse accessor claims 40
+// million vertices took 3 GB. With the cap such a file fails in a fraction of a second
+// (std::bad_alloc, "not enough memory"); real files need far less (a 100 MB binary PLY, 25 GB
+// allowed). Not under AddressSanitizer, whose shadow memory reserves terabytes of address space
+// (the fuzzers bound the reader's time instead: setMeshReadTimeLimitForTesting).
 void capAddressSpace([[maybe_unused]] const std::filesystem::path& file,
                      [[maybe_unused]] std::string_view extension) {
 #ifndef GLINT_READER_UNDER_ASAN
-  if (extension == ".gltf") return;
   std::error_code error;
-  const std::uintmax_t size = std::filesystem::file_size(file, error);
+  std::uintmax_t size = std::filesystem::file_size(file, error);
   if (error) return;
+  if (extension == ".gltf") size = gltfBytes(file, size);
   long pages = 0;
   if (std::FILE* statm = std::fopen("/proc/self/statm", "r")) {
     if (std::fscanf(statm, "%ld", &pages) != 1) pages = 0;
