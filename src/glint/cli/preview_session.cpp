@@ -115,6 +115,9 @@ void PreviewSession::end(PreviewPhase phase, const std::string& text, const std:
     while (!stop && Clock::now() < deadline)
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
+  // The outcome reaches the open pages before the server stops (a second at most: a page that
+  // does not read is not waited for longer).
+  server_->drain(std::chrono::seconds(1));
   server_->stop();
 }
 

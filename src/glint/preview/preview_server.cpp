@@ -32,8 +32,9 @@ constexpr int kMaxStreams = 6;
 constexpr auto kStreamWait = 200ms;
 // While rendering, the status (progress, elapsed time, ETA) is sent at most this often.
 constexpr auto kStatusInterval = 250ms;
-// A comment line keeps idle streams open through proxies and finds closed ones.
-constexpr auto kKeepAliveInterval = 5s;
+// A comment line keeps idle streams open through proxies and finds closed ones: a page closed or
+// reloaded gives its stream's place back within this time.
+constexpr auto kKeepAliveInterval = 1s;
 // Blocks per event: a large image's first update comes as several events of bounded size.
 constexpr std::size_t kTilesPerEvent = 256;
 
@@ -123,6 +124,7 @@ struct PreviewServer::Impl {
   int port = 0;
   std::unique_ptr<preview_http::Server> server;
   std::atomic<int> streams{0};
+  std::atomic<int> streamsFinal{0};  // open streams that have sent the render's outcome
   bool stopped = false;
 
   std::unique_ptr<preview_http::EventStream> openStream();
@@ -134,8 +136,12 @@ namespace {
 // events, and a comment now and then to keep it open.
 class StateStream final : public preview_http::EventStream {
  public:
-  StateStream(PreviewState& state, std::atomic<int>& streams) : state_(state), streams_(streams) {}
-  ~StateStream() override { streams_.fetch_sub(1); }
+  StateStream(PreviewState& state, std::atomic<int>& streams, std::atomic<int>& streamsFinal)
+      : state_(state), streams_(streams), streamsFinal_(streamsFinal) {}
+  ~StateStream() override {
+    if (sentFinal_) streamsFinal_.fetch_sub(1);
+    streams_.fetch_sub(1);
+  }
 
   bool writeNext(const Write& sink) override {
     if (state_.isClosed()) return false;
@@ -163,6 +169,11 @@ class StateStream final : public preview_http::EventStream {
       if (!write(status)) return false;
       lastStatus_ = std::move(status);
       statusSent_ = now;
+      const PreviewPhase phase = changes.status.phase;
+      if (!sentFinal_ && phase != PreviewPhase::Loading && phase != PreviewPhase::Rendering) {
+        sentFinal_ = true;
+        streamsFinal_.fetch_add(1);
+      }
     }
     if (now - lastWrite_ >= kKeepAliveInterval && !write(": keep-alive\n\n")) return false;
     return true;
@@ -171,6 +182,8 @@ class StateStream final : public preview_http::EventStream {
  private:
   PreviewState& state_;
   std::atomic<int>& streams_;
+  std::atomic<int>& streamsFinal_;
+  bool sentFinal_ = false;
   std::uint64_t version_ = 0;
   std::string lastStatus_;
   Clock::time_point statusSent_{};
@@ -185,7 +198,7 @@ std::unique_ptr<preview_http::EventStream> PreviewServer::Impl::openStream() {
     streams.fetch_sub(1);
     return nullptr;
   }
-  return std::make_unique<StateStream>(state, streams);
+  return std::make_unique<StateStream>(state, streams, streamsFinal);
 }
 
 PreviewServer::PreviewServer(PreviewState& state, const std::string& address, int port)
@@ -223,6 +236,12 @@ std::string PreviewServer::url() const {
   const bool v6 = impl_->address.find(':') != std::string::npos;
   return v6 ? fmt::format("http://[{}]:{}/", impl_->address, impl_->port)
             : fmt::format("http://{}:{}/", impl_->address, impl_->port);
+}
+
+void PreviewServer::drain(std::chrono::milliseconds limit) {
+  const auto deadline = Clock::now() + limit;
+  while (impl_->streamsFinal.load() < impl_->streams.load() && Clock::now() < deadline)
+    std::this_thread::sleep_for(5ms);
 }
 
 void PreviewServer::stop() {

@@ -3,6 +3,7 @@
 // is 404 and every method but GET is 405.
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -31,6 +32,9 @@ class PreviewServer {
 
   int port() const;         // the bound port (the chosen one when asked for 0)
   std::string url() const;  // "http://127.0.0.1:8642/", "http://[::1]:8642/"
+  // Waits (at most `limit`) until every open page has been sent the render's outcome (the state's
+  // ended() has been called): a stop right after ended() closed streams before they sent it.
+  void drain(std::chrono::milliseconds limit);
   // Closes the state's streams and the listening socket and waits for the server's threads.
   void stop();
 

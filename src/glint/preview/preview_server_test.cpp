@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 #include <httplib.h>
 
+#include <atomic>
 #include <chrono>
 #include <string>
+#include <thread>
 
 namespace glint {
 namespace {
@@ -146,6 +148,35 @@ TEST(PreviewServer, StopsPromptlyWithAStreamOpen) {
   server.reset();
   EXPECT_LT(std::chrono::steady_clock::now() - start, 3s);
   reader.join();
+}
+
+// The render's outcome reaches an open page before the server stops: ended() then drain() then
+// stop(), as a render that ends without lingering (or is interrupted) does. Without the drain the
+// stream was closed before it sent the outcome in most runs.
+TEST(PreviewServer, AnOpenPageIsSentTheOutcomeBeforeTheServerStops) {
+  for (int run = 0; run < 5; ++run) {
+    PreviewState state("s");
+    const PixelRegion whole{0, 0, 20, 10};
+    state.sceneBuilt("", whole, Encoding::Linear);
+    state.renderStarting(0, 2);
+    auto server = std::make_unique<PreviewServer>(state, "127.0.0.1", 0);
+    httplib::Client client("127.0.0.1", server->port());
+    std::string received;
+    std::atomic<bool> streaming{false};
+    std::thread reader([&]() {
+      client.Get("/events", [&](const char* data, std::size_t length) {
+        received.append(data, length);
+        streaming = true;
+        return true;
+      });
+    });
+    while (!streaming) std::this_thread::sleep_for(5ms);
+    state.ended(PreviewPhase::Interrupted, "interrupted");
+    server->drain(2s);
+    server->stop();
+    reader.join();
+    EXPECT_NE(received.find("\"phase\":\"interrupted\""), std::string::npos) << received;
+  }
 }
 
 }  // namespace
