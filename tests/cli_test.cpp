@@ -580,12 +580,29 @@ TEST_F(Cli, SecondSigintEndsTheRenderAtOnceAndWritesNothing) {
     std::this_thread::sleep_for(2ms);
   std::this_thread::sleep_for(300ms);
   kill(pid, SIGINT);
-  std::this_thread::sleep_for(1ms);
+  std::this_thread::sleep_for(300ms);  // past the 250 ms within which a repeat is the same request
   kill(pid, SIGINT);
   const RunResult r = finish(pid, 30s);
   EXPECT_EQ(r.status, 130) << r.err;
   EXPECT_TRUE(contains(r.err, "glint: interrupted")) << r.err;
   EXPECT_TRUE(filesIn(work_).empty());
+}
+
+// GNU timeout sends its signal to the command and then to the whole process group: the same
+// signal twice within microseconds is one request, and the checkpoint is still saved.
+TEST_F(Cli, TheSameSignalTwiceAtOnceIsOneRequestAndTheCheckpointIsSaved) {
+  const pid_t pid = start(
+      {"render", (kScenes / "heavy.yaml").string(), "-o", "out.png", "--checkpoint", "run.ckpt"});
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (!catchesSignal(pid, SIGINT) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(2ms);
+  std::this_thread::sleep_for(300ms);
+  kill(pid, SIGINT);
+  kill(pid, SIGINT);
+  const RunResult r = finish(pid, 30s);
+  EXPECT_EQ(r.status, 130) << r.err;
+  EXPECT_TRUE(contains(r.err, "tiles saved to 'run.ckpt'")) << r.err;
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{"run.ckpt"});
 }
 
 TEST_F(Cli, SigtermStopsTheRenderWith143AndKeepsTheExistingOutput) {

@@ -1,6 +1,7 @@
 #include "glint/cli/signal_guard.h"
 
 #include <signal.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <array>
@@ -13,7 +14,20 @@ std::atomic<bool> gCancel{false};
 std::atomic<int> gSignal{0};
 std::atomic<bool> gCommitting{false};
 std::atomic<bool> gReported{false};  // the guard is gone after a stop: the interrupt is reported
-static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free);
+std::atomic<long long> gFirstAt{0};  // CLOCK_MONOTONIC nanoseconds of the first stop signal
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free &&
+              std::atomic<long long>::is_always_lock_free);
+
+// A repeat of the first signal within this time is the same request, not a second one: GNU
+// timeout sends its signal to the command and then to the whole process group, so the command
+// gets it twice within microseconds (and an ended render's checkpoint must still be saved).
+constexpr long long kSameRequestNanoseconds = 250'000'000;
+
+long long monotonicNanoseconds() {
+  timespec now{};
+  clock_gettime(CLOCK_MONOTONIC, &now);  // async-signal-safe
+  return static_cast<long long>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+}
 
 constexpr std::array<int, 3> kHandledSignals{SIGINT, SIGTERM, SIGHUP};
 std::array<struct sigaction, kHandledSignals.size()> gPrevious{};
@@ -24,7 +38,11 @@ std::array<struct sigaction, kIgnoredSignals.size()> gPreviousIgnored{};
 extern "C" void onStopSignal(int signal) {
   int expected = 0;
   if (gSignal.compare_exchange_strong(expected, signal)) {
+    gFirstAt.store(monotonicNanoseconds());
     gCancel.store(true);
+    return;
+  }
+  if (signal == expected && monotonicNanoseconds() - gFirstAt.load() < kSameRequestNanoseconds) {
     return;
   }
   // A second signal: the user insists. Only write(2) and _exit(2) here (async-signal-safe).
@@ -41,6 +59,7 @@ extern "C" void onStopSignal(int signal) {
 SignalGuard::SignalGuard() {
   gCancel.store(false);
   gSignal.store(0);
+  gFirstAt.store(0);
   gCommitting.store(false);
   gReported.store(false);
   struct sigaction action {};
