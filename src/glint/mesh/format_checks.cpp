@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -208,6 +209,53 @@ std::uint64_t accessorCount(const ValueView& accessors, const ValueView& index) 
   }
 }
 
+// A whole number of a glTF document, or `otherwise` when it is absent or not one.
+std::uint64_t wholeNumber(const ValueView& value, std::uint64_t otherwise) {
+  if (!value.isScalar()) return otherwise;
+  const std::string_view text = value.scalar();
+  std::uint64_t number = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), number);
+  return error == std::errc{} && end == text.data() + text.size() ? number : otherwise;
+}
+
+// Bytes of one component of an accessor's componentType (5120 byte ... 5126 float); 0 for none.
+std::uint64_t componentBytes(std::string_view componentType) {
+  if (componentType == "5120" || componentType == "5121") return 1;
+  if (componentType == "5122" || componentType == "5123") return 2;
+  if (componentType == "5125" || componentType == "5126") return 4;
+  return 0;
+}
+
+// Every accessor aligned as glTF 2.0 requires ("Data Alignment": its offset within its buffer view
+// and within the buffer, and the view's stride, multiples of its component size). assimp reads a
+// misaligned accessor where it lies: vertices of garbage bits, silently.
+void checkGltfAlignment(const ValueView& accessors, const ValueView& bufferViews) {
+  for (std::size_t a = 0; a < accessors.size(); ++a) {
+    const ValueView accessor = accessors[a];
+    const std::uint64_t component = componentBytes(accessor.find("componentType").scalar());
+    if (component == 0) continue;
+    const std::uint64_t offset = wholeNumber(accessor.find("byteOffset"), 0);
+    const ValueView view =
+        bufferViews[wholeNumber(accessor.find("bufferView"), bufferViews.size())];
+    const std::uint64_t viewOffset = wholeNumber(view.find("byteOffset"), 0);
+    const std::uint64_t stride = wholeNumber(view.find("byteStride"), 0);
+    std::string fault;
+    if (offset % component != 0) {
+      fault = fmt::format("starts at byte {} of its buffer view", offset);
+    } else if ((viewOffset + offset) % component != 0) {
+      fault = fmt::format("starts at byte {} of its buffer", viewOffset + offset);
+    } else if (stride % component != 0) {
+      fault = fmt::format("has a buffer view of stride {}", stride);
+    }
+    if (!fault.empty()) {
+      throw MeshLoadError(fmt::format(
+          "invalid file: accessor {} {}, not a multiple of its component size ({} bytes), as glTF "
+          "2.0 requires",
+          a, fault, component));
+    }
+  }
+}
+
 }  // namespace
 
 void checkGltfPrimitives(const std::filesystem::path& path, const std::string& extension,
@@ -246,13 +294,20 @@ void checkGltfPrimitives(const std::filesystem::path& path, const std::string& e
     for (std::size_t p = 0; p < primitives.size(); ++p) {
       const ValueView primitive = primitives[p];
       const std::string_view mode = primitive.find("mode").scalar();
-      const std::uint64_t minimum = mode == "3" ? 2 : (mode == "5" || mode == "6") ? 3 : 0;
-      if (minimum == 0) continue;
       const ValueView indices = primitive.find("indices");
       const std::uint64_t count =
           indices.isDefined()
               ? accessorCount(accessors, indices)
               : accessorCount(accessors, primitive.find("attributes").find("POSITION"));
+      // Triangles (mode 4, the default): three vertices each. assimp drops what is left over.
+      if ((mode.empty() || mode == "4") && count % 3 != 0) {
+        throw MeshLoadError(fmt::format(
+            "invalid file: primitive {} of mesh {} is a list of triangles of {} {}, not a "
+            "multiple of 3",
+            p, m, count, indices.isDefined() ? "indices" : "vertices"));
+      }
+      const std::uint64_t minimum = mode == "3" ? 2 : (mode == "5" || mode == "6") ? 3 : 0;
+      if (minimum == 0) continue;
       if (count < minimum) {
         throw MeshLoadError(fmt::format(
             "invalid file: primitive {} of mesh {} is a {} of {} vertices (at least {} needed)", p,
@@ -264,6 +319,7 @@ void checkGltfPrimitives(const std::filesystem::path& path, const std::string& e
       }
     }
   }
+  checkGltfAlignment(accessors, json.root().find("bufferViews"));
 }
 
 }  // namespace glint
