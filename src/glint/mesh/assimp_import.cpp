@@ -37,6 +37,7 @@
 #include "glint/mesh/obj_check.h"
 #include "glint/mesh/obj_fast_parse.h"
 #include "glint/mesh/ply_check.h"
+#include "glint/mesh/stl_check.h"
 #include "glint/scene/scene_limits.h"
 
 namespace glint {
@@ -588,9 +589,11 @@ MeshFile importMeshWithAssimp(const std::filesystem::path& path, const std::stri
 
 namespace {
 
-// Refuses a PLY file whose body disagrees with its header (ply_check.h), at its place.
-void checkPlyBody(const std::filesystem::path& path, const ReferencedFileRule& rule) {
-  std::optional<PlyFault> fault;
+// Refuses a PLY file whose body disagrees with its header (ply_check.h), or an ASCII STL file with
+// a malformed statement (stl_check.h), at its place; `find` is the check.
+void checkMeshText(const std::filesystem::path& path, const ReferencedFileRule& rule,
+                   std::optional<MeshFileFault> (*find)(std::string_view)) {
+  std::optional<MeshFileFault> fault;
   {
     MeshFileAccess files(rule);
     const ReadableFile file = files.openChecked(path.c_str());
@@ -600,7 +603,7 @@ void checkPlyBody(const std::filesystem::path& path, const ReferencedFileRule& r
     void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd, 0);
     if (mapped == MAP_FAILED) return;  // assimp's words for it
     try {
-      fault = findPlyFault(std::string_view(static_cast<const char*>(mapped), size));
+      fault = find(std::string_view(static_cast<const char*>(mapped), size));
     } catch (...) {
       ::munmap(mapped, size);
       throw;
@@ -620,7 +623,8 @@ void checkPlyBody(const std::filesystem::path& path, const ReferencedFileRule& r
 
 MeshFile importMesh(const std::filesystem::path& path, const std::string& extension,
                     const ReferencedFileRule& rule) {
-  if (extension == ".ply") checkPlyBody(path, rule);
+  if (extension == ".ply") checkMeshText(path, rule, findPlyFault);
+  if (extension == ".stl") checkMeshText(path, rule, findStlFault);
   if (extension == ".obj" && !objFastPathDisabled()) {
     if (std::optional<MeshFile> file = importSimpleObj(path, rule)) return std::move(*file);
   }

@@ -150,7 +150,7 @@ TEST(MeshFormatChecks, AGltfWhoseAccessorsClaimMoreThanItsBuffersHoldFailsForMem
   const std::string gltf =
       R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
           "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-          "accessors": [{"componentType": 5126, "count": 40000000, "type": "VEC3",
+          "accessors": [{"componentType": 5126, "count": 39999999, "type": "VEC3",
                          "min": [0, 0, 0], "max": [1, 2, 3],
                          "sparse": {"count": 1, "indices": {"bufferView": 0, "componentType": 5125},
                                     "values": {"bufferView": 1}}}],

@@ -7,6 +7,8 @@
 #include <cstring>
 #include <vector>
 
+#include "glint/mesh/file_fault.h"
+
 namespace glint {
 namespace {
 
@@ -128,17 +130,6 @@ std::string quoted(std::string_view token) {
   return "'" + out + (token.size() > 40 ? "...'" : "'");
 }
 
-// A number as assimp's PLY reader takes one: an optional sign, then a decimal float (digits with
-// an optional fraction and exponent), nan or inf.
-bool isNumber(std::string_view token) {
-  if (!token.empty() && (token[0] == '-' || token[0] == '+')) token.remove_prefix(1);
-  if (token.empty() || token[0] == '-' || token[0] == '+') return false;
-  double value = 0;
-  const auto [ptr, error] = std::from_chars(token.data(), token.data() + token.size(), value);
-  return ptr == token.data() + token.size() &&
-         (error == std::errc{} || error == std::errc::result_out_of_range);
-}
-
 // A list's count: a whole number within its type (no sign for an unsigned type).
 std::optional<std::uint64_t> listCount(std::string_view token, const PlyType& type) {
   if (!token.empty() && token[0] == '+') token.remove_prefix(1);
@@ -206,7 +197,7 @@ std::optional<PlyFault> asciiFault(std::string_view file, const Header& header) 
         std::string_view token = nextToken();
         if (token.empty()) return shortLine(fmt::format("no value for '{}'", property.name));
         if (!property.list) {
-          if (!isNumber(token)) return notANumber(token, property);
+          if (!isNumberWord(token)) return notANumber(token, property);
           continue;
         }
         const std::optional<std::uint64_t> count = listCount(token, property.countType);
@@ -222,7 +213,7 @@ std::optional<PlyFault> asciiFault(std::string_view file, const Header& header) 
             return shortLine(
                 fmt::format("'{}' holds {} of its {} values", property.name, k, *count));
           }
-          if (!isNumber(token)) return notANumber(token, property);
+          if (!isNumberWord(token)) return notANumber(token, property);
         }
       }
       const std::string_view extra = nextToken();

@@ -10,13 +10,11 @@
 #include <string>
 #include <string_view>
 
+#include "glint/mesh/file_fault.h"
+
 namespace glint {
 
-struct PlyFault {
-  std::size_t line = 0;    // 1-based; 0 for a binary body (no lines)
-  std::size_t column = 0;  // 1-based, in bytes
-  std::string what;        // e.g. "the file ends in 'face' 2 of 3 ..."
-};
+using PlyFault = MeshFileFault;
 
 // The first way the body disagrees with the header, or nothing. The header is read as
 // checkPlyHeader (format_checks.h) reads it, which has passed already. Element instances are
