@@ -33,7 +33,7 @@ inline constexpr std::uint64_t kMaxMeshTriangles = std::uint64_t{1} << 28;
 // to a few thousand corners.
 inline constexpr std::uint32_t kMaxFaceCorners = 16384;
 
-// Crease angle of generated smooth normals (degrees; assimp's GenSmoothNormals): the normal at a
+// Crease angle of generated smooth normals (degrees; generateSmoothNormals): the normal at a
 // corner of a triangle averages the normals of the triangles around that vertex whose normals are
 // within this angle of the corner's own triangle. Edges sharper than it — a box's 90° edges — stay
 // hard; the smooth surfaces of a finely divided model get one normal per vertex.

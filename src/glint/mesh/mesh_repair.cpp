@@ -2,8 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <limits>
+#include <numbers>
 #include <utility>
+#include <vector>
 
 #include <assimp/mesh.h>
 #include <assimp/scene.h>
@@ -453,6 +457,200 @@ TriangleMesh convertMesh(const aiMesh& in, JoinedMesh&& joined) {
 TriangleMesh joinSimpleObj(const SimpleObj& obj, std::size_t& dropped) {
   const SimpleObjVertices vertices(obj);
   return convertVertices(vertices, joinVertices(vertices, dropped));
+}
+
+namespace {
+
+struct Double3 {
+  double x = 0, y = 0, z = 0;
+};
+
+Double3 toDouble(const aiVector3D& v) { return {v.x, v.y, v.z}; }
+
+bool isFinite(const Double3& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+}
+
+// A hash of a float position's exact bits.
+std::uint64_t positionHash(const aiVector3D& v) {
+  std::uint32_t bits[3];
+  std::memcpy(bits, &v.x, 4);
+  std::memcpy(bits + 1, &v.y, 4);
+  std::memcpy(bits + 2, &v.z, 4);
+  std::uint64_t h = bits[0] * 0x9E3779B97F4A7C15ull;
+  h = (h ^ (h >> 29) ^ bits[1]) * 0xBF58476D1CE4E5B9ull;
+  h = (h ^ (h >> 31) ^ bits[2]) * 0x94D049BB133111EBull;
+  return h ^ (h >> 32);
+}
+
+bool samePosition(const aiVector3D& a, const aiVector3D& b) {
+  return std::memcmp(&a, &b, sizeof(aiVector3D)) == 0;
+}
+
+}  // namespace
+
+void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
+  const std::size_t n = mesh.mNumVertices;
+  if (n == 0 || mesh.mVertices == nullptr) return;
+  const aiVector3D* vertices = mesh.mVertices;
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  // Each face's unit normal, and each vertex's face: the last one that uses it.
+  std::vector<Double3> faceNormal(mesh.mNumFaces);
+  std::vector<std::uint32_t> faceOf(n, kNone);
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+    const aiFace& face = mesh.mFaces[f];
+    if (face.mNumIndices < 3) continue;
+    const Double3 p0 = toDouble(vertices[face.mIndices[0]]);
+    const Double3 p1 = toDouble(vertices[face.mIndices[1]]);
+    const Double3 p2 = toDouble(vertices[face.mIndices[face.mNumIndices - 1]]);
+    const Double3 a{p1.x - p0.x, p1.y - p0.y, p1.z - p0.z};
+    const Double3 b{p2.x - p0.x, p2.y - p0.y, p2.z - p0.z};
+    Double3 normal{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+    const double length =
+        std::sqrt(normal.x * normal.x + normal.y * normal.y + normal.z * normal.z);
+    if (length > 0) normal = {normal.x / length, normal.y / length, normal.z / length};
+    faceNormal[f] = normal;
+    for (unsigned k = 0; k < face.mNumIndices; ++k) faceOf[face.mIndices[k]] = f;
+  }
+
+  // Distinct positions (an open-addressing table of their first vertex), and the vertices at each
+  // as compressed rows.
+  const std::size_t slots = n + n / 2 + 1;
+  std::vector<std::uint32_t> slot(slots, kNone);
+  std::vector<std::uint32_t> positionOf(n);
+  std::vector<std::uint32_t> firstVertex;  // of each distinct position
+  for (std::size_t v = 0; v < n; ++v) {
+    std::size_t at = static_cast<std::size_t>(positionHash(vertices[v]) % slots);
+    while (slot[at] != kNone && !samePosition(vertices[firstVertex[slot[at]]], vertices[v])) {
+      at = at + 1 == slots ? 0 : at + 1;
+    }
+    if (slot[at] == kNone) {
+      slot[at] = static_cast<std::uint32_t>(firstVertex.size());
+      firstVertex.push_back(static_cast<std::uint32_t>(v));
+    }
+    positionOf[v] = slot[at];
+  }
+  slot = {};
+  const std::size_t positions = firstVertex.size();
+  std::vector<std::uint32_t> rowStart(positions + 1, 0);
+  for (std::size_t v = 0; v < n; ++v) ++rowStart[positionOf[v] + 1];
+  for (std::size_t p = 0; p < positions; ++p) rowStart[p + 1] += rowStart[p];
+  std::vector<std::uint32_t> verticesAt(n);
+  {
+    std::vector<std::uint32_t> fill(rowStart.begin(), rowStart.end() - 1);
+    for (std::size_t v = 0; v < n; ++v) {
+      verticesAt[fill[positionOf[v]]++] = static_cast<std::uint32_t>(v);
+    }
+  }
+
+  // Epsilon: 1e-4 of the bounding box's diagonal (finite positions).
+  constexpr double infinity = std::numeric_limits<double>::infinity();
+  Double3 lo{infinity, infinity, infinity};
+  Double3 hi{-infinity, -infinity, -infinity};
+  for (std::size_t p = 0; p < positions; ++p) {
+    const Double3 q = toDouble(vertices[firstVertex[p]]);
+    if (!isFinite(q)) continue;
+    lo = {std::min(lo.x, q.x), std::min(lo.y, q.y), std::min(lo.z, q.z)};
+    hi = {std::max(hi.x, q.x), std::max(hi.y, q.y), std::max(hi.z, q.z)};
+  }
+  const Double3 extent{hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
+  const double diagonal =
+      isFinite(lo) && isFinite(hi)
+          ? std::sqrt(extent.x * extent.x + extent.y * extent.y + extent.z * extent.z)
+          : 0;
+  const double epsilon = 1e-4 * diagonal;
+
+  // The distinct positions within epsilon of each (itself included): a grid of cells 16 epsilon
+  // wide, sorted by cell, each position looking in its own cell and the neighbours its epsilon
+  // ball reaches into.
+  std::vector<std::uint32_t> nearStart(positions + 1, 0);
+  std::vector<std::uint32_t> near;
+  near.reserve(positions);
+  const double cell = 16 * epsilon;
+  // Cells along an axis: at most diagonal / cell + 1 = 626, so 21 bits each make a key.
+  const auto cellOf = [&](double value, double origin) {
+    return static_cast<std::int64_t>(std::floor((value - origin) / cell));
+  };
+  const auto keyOf = [](std::int64_t cx, std::int64_t cy, std::int64_t cz) {
+    return (static_cast<std::uint64_t>(cx + 1) << 42) | (static_cast<std::uint64_t>(cy + 1) << 21) |
+           static_cast<std::uint64_t>(cz + 1);
+  };
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> byCell;
+  const bool grid = epsilon > 0 && std::isfinite(cell);
+  if (grid) {
+    byCell.reserve(positions);
+    for (std::size_t p = 0; p < positions; ++p) {
+      const Double3 q = toDouble(vertices[firstVertex[p]]);
+      if (!isFinite(q)) continue;
+      byCell.emplace_back(keyOf(cellOf(q.x, lo.x), cellOf(q.y, lo.y), cellOf(q.z, lo.z)),
+                          static_cast<std::uint32_t>(p));
+    }
+    std::sort(byCell.begin(), byCell.end());
+  }
+  const double squaredEpsilon = epsilon * epsilon;
+  for (std::size_t p = 0; p < positions; ++p) {
+    const Double3 q = toDouble(vertices[firstVertex[p]]);
+    if (!grid || !isFinite(q)) {
+      near.push_back(static_cast<std::uint32_t>(p));
+      nearStart[p + 1] = static_cast<std::uint32_t>(near.size());
+      continue;
+    }
+    const std::int64_t c[3] = {cellOf(q.x, lo.x), cellOf(q.y, lo.y), cellOf(q.z, lo.z)};
+    const double at[3] = {q.x - lo.x, q.y - lo.y, q.z - lo.z};
+    std::int64_t from[3];
+    std::int64_t to[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      const double low = static_cast<double>(c[axis]) * cell;
+      from[axis] = c[axis] - (at[axis] - epsilon < low ? 1 : 0);
+      to[axis] = c[axis] + (at[axis] + epsilon >= low + cell ? 1 : 0);
+    }
+    for (std::int64_t x = from[0]; x <= to[0]; ++x) {
+      for (std::int64_t y = from[1]; y <= to[1]; ++y) {
+        for (std::int64_t z = from[2]; z <= to[2]; ++z) {
+          const std::uint64_t key = keyOf(x, y, z);
+          auto it = std::lower_bound(byCell.begin(), byCell.end(),
+                                     std::pair<std::uint64_t, std::uint32_t>{key, 0});
+          for (; it != byCell.end() && it->first == key; ++it) {
+            const std::uint32_t other = it->second;
+            const Double3 r = toDouble(vertices[firstVertex[other]]);
+            const double dx = r.x - q.x, dy = r.y - q.y, dz = r.z - q.z;
+            if (other == p || dx * dx + dy * dy + dz * dz < squaredEpsilon) near.push_back(other);
+          }
+        }
+      }
+    }
+    nearStart[p + 1] = static_cast<std::uint32_t>(near.size());
+  }
+
+  // Each vertex: the sum of the face normals within the crease angle at positions within epsilon.
+  const double cosLimit = std::cos(creaseDegrees * std::numbers::pi / 180);
+  if (mesh.mNormals == nullptr) mesh.mNormals = new aiVector3D[n];
+  for (std::size_t v = 0; v < n; ++v) {
+    if (faceOf[v] == kNone) {
+      mesh.mNormals[v] = aiVector3D(std::numeric_limits<float>::quiet_NaN());
+      continue;
+    }
+    const Double3 own = faceNormal[faceOf[v]];
+    Double3 sum;
+    const std::uint32_t p = positionOf[v];
+    for (std::uint32_t k = nearStart[p]; k < nearStart[p + 1]; ++k) {
+      const std::uint32_t other = near[k];
+      for (std::uint32_t j = rowStart[other]; j < rowStart[other + 1]; ++j) {
+        const std::uint32_t w = verticesAt[j];
+        if (faceOf[w] == kNone) continue;
+        const Double3& normal = faceNormal[faceOf[w]];
+        if (w != v && !(normal.x * own.x + normal.y * own.y + normal.z * own.z >= cosLimit)) {
+          continue;
+        }
+        sum = {sum.x + normal.x, sum.y + normal.y, sum.z + normal.z};
+      }
+    }
+    const double length = std::sqrt(sum.x * sum.x + sum.y * sum.y + sum.z * sum.z);
+    const double scale = length > 0 ? 1 / length : 1;
+    mesh.mNormals[v] =
+        aiVector3D(static_cast<float>(sum.x * scale), static_cast<float>(sum.y * scale),
+                   static_cast<float>(sum.z * scale));
+  }
 }
 
 }  // namespace glint

@@ -23,17 +23,27 @@ struct SimpleObj;
 // triangles removed. Faces of one or two indices (points, lines) stay for SortByPType to remove.
 std::size_t dropInvalidFaces(aiScene& scene);
 
-// Gives every face corner of a mesh without normals its own vertex, before GenSmoothNormals.
-// That step first stores each face's normal at its vertices — a vertex shared by several faces
-// keeps only the last one — and then averages the normals of the vertices at the same position
-// within the crease angle. Indexed files (PLY, glTF) share a vertex among all faces around it, so a
-// smooth surface got one face's normal per vertex (faceted, lopsided shading) and a crease could
-// not be kept. One vertex per corner, as assimp's OBJ and STL importers already give, lets every
-// corner average exactly the faces within the crease angle; glint's join (joinMesh) shares them
-// again afterwards. The first set of texture coordinates follows the corners; colours, tangents and
-// further sets are dropped (glint reads none of them); meshes with bones are left alone (their
-// weights index the vertices).
+// Gives every face corner of a mesh without normals its own vertex, before generateSmoothNormals.
+// That step (as assimp's GenSmoothNormals) first stores each face's normal at its vertices — a
+// vertex shared by several faces keeps only the last one — and then averages the normals of the
+// vertices at the same position within the crease angle. Indexed files (PLY, glTF) share a vertex
+// among all faces around it, so a smooth surface got one face's normal per vertex (faceted,
+// lopsided shading) and a crease could not be kept. One vertex per corner, as assimp's OBJ and STL
+// importers already give, lets every corner average exactly the faces within the crease angle;
+// glint's join (joinMesh) shares them again afterwards. The first set of texture coordinates
+// follows the corners; colours, tangents and further sets are dropped (glint reads none of them);
+// meshes with bones are left alone (their weights index the vertices).
 void splitSharedCorners(aiScene& scene);
+
+// Vertex normals for a mesh without them (after splitSharedCorners and assimp's triangulation), as
+// assimp's GenSmoothNormals step defines them but in O(n) instead of its spatial sort's O(n^1.5)
+// (7.5 s of a 1M-triangle file's load): each vertex first takes the unit normal of the last face
+// that uses it (p1 − p0) × (p_last − p0); then its normal is the normalised sum of those normals
+// over the vertices within epsilon of its position (1e-4 of the mesh's bounding-box diagonal)
+// whose normal lies within `creaseDegrees` of its own (itself always). Vertices within epsilon are
+// found through a grid of cells 16 epsilon wide over the distinct positions. Computed in double
+// precision, stored as floats; a vertex of no face gets NaN (convertMesh rebuilds it or drops it).
+void generateSmoothNormals(aiMesh& mesh, double creaseDegrees);
 
 // Faces of at least three corners in all meshes of the scene.
 std::size_t facesWithTriangles(const aiScene& scene);
@@ -43,8 +53,8 @@ std::size_t facesWithTriangles(const aiScene& scene);
 // of first use by the kept triangles. assimp's importers give OBJ and STL one vertex per face
 // corner; glint joins them here, exactly and in O(n) with a hash table, instead of assimp's
 // JoinIdenticalVertices (which compares within an epsilon through a spatial sort: ~0.1 s of a 0.3 s
-// load for a 100k-triangle OBJ). GenSmoothNormals has already run (assimp runs it before any join),
-// so the normals of a crease differ and its vertices stay split.
+// load for a 100k-triangle OBJ). generateSmoothNormals has already run (before any join), so the
+// normals of a crease differ and its vertices stay split.
 struct JoinedMesh {
   std::vector<std::uint32_t> indices;  // three per kept triangle, into `source`
   std::vector<std::uint32_t> source;   // the assimp vertex each joined vertex copies

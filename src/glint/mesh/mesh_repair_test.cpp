@@ -3,6 +3,7 @@
 // kept, degenerate and invalid triangles dropped and counted, invalid file normals rebuilt.
 #include "glint/mesh/mesh_repair.h"
 
+#include <assimp/mesh.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -137,6 +139,92 @@ std::string icosahedronPly() {
   for (const std::string& v : ico.vertices) ply << v << "\n";
   for (const auto& f : ico.faces) ply << "3 " << f[0] << " " << f[1] << " " << f[2] << "\n";
   return ply.str();
+}
+
+// generateSmoothNormals against its definition computed the slow way (every pair of vertices):
+// the normalised sum of the unit face normals of the vertices within epsilon (1e-4 of the
+// bounding box's diagonal) whose face lies within the crease angle — on a bumpy sphere of one
+// vertex per corner, some corners moved by 0.3 epsilon (still merged) or 3 epsilon (not).
+TEST(MeshRepair, GeneratedNormalsFollowTheirDefinition) {
+  constexpr int kRings = 12;
+  constexpr int kSegments = 24;
+  const auto point = [&](int ring, int segment) {
+    const double theta = std::numbers::pi * ring / kRings;
+    const double phi = 2 * std::numbers::pi * segment / kSegments;
+    const double radius = 1 + 0.15 * std::sin(3 * theta) * std::cos(5 * phi);  // bumps and creases
+    return Point3{radius * std::sin(theta) * std::cos(phi), radius * std::cos(theta),
+                  radius * std::sin(theta) * std::sin(phi)};
+  };
+  std::vector<Point3> corners;
+  for (int r = 0; r < kRings; ++r) {
+    for (int s = 0; s < kSegments; ++s) {
+      const Point3 a = point(r, s), b = point(r + 1, s), c = point(r + 1, s + 1),
+                   d = point(r, s + 1);
+      for (const Point3& p : {a, b, c, a, c, d}) corners.push_back(p);
+    }
+  }
+  const double epsilon = 1e-4 * std::sqrt(2.0 * 2.0 * 3);  // the bumps stay within ±1.15: close
+  for (std::size_t i = 0; i < corners.size(); i += 37) corners[i].x += 0.3 * epsilon;
+  for (std::size_t i = 5; i < corners.size(); i += 41) corners[i].y += 3 * epsilon;
+
+  aiMesh mesh;
+  mesh.mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  mesh.mNumVertices = static_cast<unsigned>(corners.size());
+  mesh.mVertices = new aiVector3D[corners.size()];
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    mesh.mVertices[i] =
+        aiVector3D(static_cast<float>(corners[i].x), static_cast<float>(corners[i].y),
+                   static_cast<float>(corners[i].z));
+  }
+  mesh.mNumFaces = mesh.mNumVertices / 3;
+  mesh.mFaces = new aiFace[mesh.mNumFaces];
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+    mesh.mFaces[f].mNumIndices = 3;
+    mesh.mFaces[f].mIndices = new unsigned[3]{3 * f, 3 * f + 1, 3 * f + 2};
+  }
+  generateSmoothNormals(mesh, kMeshCreaseAngleDegrees);
+
+  // The definition, from the float positions as the function reads them.
+  const auto at = [&](std::size_t i) {
+    const aiVector3D& v = mesh.mVertices[i];
+    return Point3{v.x, v.y, v.z};
+  };
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    const Point3 p = at(i);
+    const double q[3] = {p.x, p.y, p.z};
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], q[k]), hi[k] = std::max(hi[k], q[k]);
+  }
+  const double eps =
+      1e-4 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  // Unit, or zero for a face of no area (the poles' triangles with two corners at the pole).
+  const auto safeNormalize = [](const Vec3& v) {
+    const double length = std::sqrt(dot(v, v));
+    return length > 0 ? v / length : v;
+  };
+  const auto faceNormal = [&](std::size_t i) {
+    const std::size_t f = i / 3;
+    return safeNormalize(cross(at(3 * f + 1) - at(3 * f), at(3 * f + 2) - at(3 * f)));
+  };
+  const double cosLimit = std::cos(kMeshCreaseAngleDegrees * std::numbers::pi / 180);
+  int merged = 0;
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    Vec3 sum;
+    for (std::size_t j = 0; j < corners.size(); ++j) {
+      const Vec3 d = at(j) - at(i);
+      if (j != i && !(dot(d, d) < eps * eps)) continue;
+      if (j != i && !(dot(faceNormal(j), faceNormal(i)) >= cosLimit)) continue;
+      if (j != i && !(at(j) == at(i))) ++merged;
+      sum = sum + faceNormal(j);
+    }
+    const Vec3 expected = safeNormalize(sum);
+    const aiVector3D& got = mesh.mNormals[i];
+    ASSERT_NEAR(got.x, expected.x, 1e-6) << i;
+    ASSERT_NEAR(got.y, expected.y, 1e-6) << i;
+    ASSERT_NEAR(got.z, expected.z, 1e-6) << i;
+  }
+  EXPECT_GT(merged, 0);  // some moved corners were within epsilon of others
 }
 
 TEST(MeshRepair, IndexedFilesWithoutNormalsGetSmoothNormalsPerVertex) {
