@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <tbb/global_control.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -170,13 +171,38 @@ int serveTiles(Session& session, const RenderJobSpec& spec) {
                  signalStatus(spec));
   };
 
+  // While the scene loads, a watcher reads the link: rank 0 may stop the job meanwhile (its own
+  // error, found before the render, or a lost rank), and a large scene's load must not keep it
+  // waiting in MPI_Finalize for minutes. A message cancels the load and is handled below; so does
+  // a stop signal.
   LoadedRender loaded;
-  try {
-    loadRender(spec, spec.threads, session.host(), loaded);
-  } catch (const Cancelled&) {
-    return stopped();
+  std::optional<Message> early;
+  {
+    std::atomic<bool> loadCancel{false};
+    std::atomic<bool> loading{true};
+    std::thread watcher([&]() {
+      while (loading.load()) {
+        if (isCancelled(spec.cancel)) loadCancel.store(true);
+        if (std::optional<Message> message = link.receive(kPoll)) {
+          early = std::move(message);
+          loadCancel.store(true);
+          return;
+        }
+      }
+    });
+    RenderJobSpec loadSpec = spec;
+    loadSpec.cancel = &loadCancel;
+    bool cancelled = false;
+    try {
+      loadRender(loadSpec, spec.threads, session.host(), loaded);
+    } catch (const Cancelled&) {
+      cancelled = true;
+    }
+    loading.store(false);
+    watcher.join();
+    if (cancelled && !early) return stopped();
   }
-  link.send(0, Tag::Hello, encodeIdentity(loaded.identity));
+  if (!early) link.send(0, Tag::Hello, encodeIdentity(loaded.identity));
 
   std::optional<TileRender> render;
   for (;;) {
@@ -188,7 +214,8 @@ int serveTiles(Session& session, const RenderJobSpec& spec) {
       const std::string reason = render->failure();
       return leave(Leaving{0, fmt::format("rendering failed: {}", reason)}, 1);
     }
-    std::optional<Message> message = link.receive(kPoll);
+    std::optional<Message> message =
+        early ? std::exchange(early, std::nullopt) : link.receive(kPoll);
     if (!message) continue;
     switch (message->tag) {
       case Tag::Assign:
