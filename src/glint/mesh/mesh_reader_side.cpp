@@ -60,6 +60,7 @@ namespace {
 #endif
 #endif
 
+#ifndef GLINT_READER_UNDER_ASAN
 // The bytes a .gltf brings: its own and those of the buffer files its `buffers` name (a data:
 // URI is inside it). A buffer that cannot be found adds nothing (assimp then fails on it).
 std::uintmax_t gltfBytes(const std::filesystem::path& file, std::uintmax_t own) {
@@ -100,6 +101,7 @@ std::uintmax_t gltfBytes(const std::filesystem::path& file, std::uintmax_t own) 
   }
   return total;
 }
+#endif
 
 // Caps this process's address space at what it uses now plus 512 MiB plus 256 bytes per byte of
 // the mesh file (for a .gltf, of it and its buffer files). assimp's ASCII PLY reader takes any
