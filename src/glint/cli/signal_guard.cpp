@@ -36,14 +36,18 @@ constexpr std::array<int, 2> kIgnoredSignals{SIGPIPE, SIGXFSZ};
 std::array<struct sigaction, kIgnoredSignals.size()> gPreviousIgnored{};
 
 extern "C" void onStopSignal(int signal) {
+  // The time is read first: the repeat may run on another thread between the first's exchange and
+  // its store, and then sees 0 — also "just now".
+  const long long now = monotonicNanoseconds();
   int expected = 0;
   if (gSignal.compare_exchange_strong(expected, signal)) {
-    gFirstAt.store(monotonicNanoseconds());
+    gFirstAt.store(now);
     gCancel.store(true);
     return;
   }
-  if (signal == expected && monotonicNanoseconds() - gFirstAt.load() < kSameRequestNanoseconds) {
-    return;
+  if (signal == expected) {
+    const long long first = gFirstAt.load();
+    if (first == 0 || now - first < kSameRequestNanoseconds) return;
   }
   // A second signal: the user insists. Only write(2) and _exit(2) here (async-signal-safe).
   if (gCommitting.load()) return;

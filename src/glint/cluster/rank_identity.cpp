@@ -36,7 +36,8 @@ std::uint64_t meshFingerprint(const Scene& scene) {
         fnv1a64(std::string_view(reinterpret_cast<const char*>(emission), sizeof emission), hash);
   }
   // The materials too: an OBJ's MTL or a glTF's materials reach the scene only through them.
-  return fnv1a64(materialBytes(scene.materials()), hash);
+  return fnv1a64(materialBytes(scene.materials(), scene.materialTextures(), scene.textures()),
+                 hash);
 }
 
 RankIdentity identityOf(const std::filesystem::path& sceneFile, std::string_view sceneBytes,

@@ -143,7 +143,9 @@ CheckpointSettings checkpointSettingsFor(const Scene& scene, const PixelRegion& 
   return s;
 }
 
-std::string materialBytes(const std::vector<Material>& materials) {
+std::string materialBytes(const std::vector<Material>& materials,
+                          const std::vector<MaterialTextures>& bindings,
+                          const std::vector<Texture>& textures) {
   Writer w;
   w.u64(materials.size());
   const auto color = [&](const Color& c) {
@@ -163,6 +165,27 @@ std::string materialBytes(const std::vector<Material>& materials) {
     w.f64(m.refractionBlur);
     w.i32(m.priority);
     w.u32(m.textures);
+  }
+  // Which texture each coefficient takes (an MTL's map_Kd or map_Ks of one image differ here),
+  // and the placement of image textures (an MTL's -s and -o); their pixels are hashed apart.
+  w.u64(bindings.size());
+  for (const MaterialTextures& b : bindings) {
+    for (const TextureId id : {b.kd, b.ks, b.kr, b.kt, b.ka, b.emission, b.normalMap, b.bumpMap})
+      w.u32(id);
+    w.f64(b.bumpScale);
+  }
+  w.u64(textures.size());
+  for (const Texture& texture : textures) {
+    w.u32(static_cast<std::uint32_t>(texture.index()));
+    if (const auto* image = std::get_if<ImageTexture>(&texture)) {
+      w.u32(static_cast<std::uint32_t>(image->filter));
+      w.f64(image->transform.repeat.x);
+      w.f64(image->transform.repeat.y);
+      w.f64(image->transform.offset.x);
+      w.f64(image->transform.offset.y);
+      w.f64(image->transform.cosRotate);
+      w.f64(image->transform.sinRotate);
+    }
   }
   return std::move(w.text());
 }
@@ -193,7 +216,8 @@ std::uint64_t renderFingerprint(std::string_view sceneFileBytes, const Scene& sc
   }
   // Every material's values: those of mesh files (an OBJ's MTL, a glTF's materials) are not in the
   // scene file's bytes.
-  hash = fnv1a64(materialBytes(scene.materials()), hash);
+  hash =
+      fnv1a64(materialBytes(scene.materials(), scene.materialTextures(), scene.textures()), hash);
   // The pictures of image textures and of the background, read from files the scene only names
   // (each once; an untextured scene adds nothing).
   std::vector<const MipMap*> images;

@@ -61,15 +61,18 @@ CheckpointSettings checkpointSettingsFor(const Scene& scene, const PixelRegion& 
 inline constexpr std::uint64_t kFnvOffsetBasis = 14695981039346656037ull;
 std::uint64_t fnv1a64(std::string_view bytes, std::uint64_t hash = kFnvOffsetBasis);
 
-// Every material's values, little-endian, in order (for fingerprints).
-std::string materialBytes(const std::vector<Material>& materials);
+// Every material's values, its texture bindings and the image textures' placement (not their
+// pixels), little-endian, in order (for fingerprints).
+std::string materialBytes(const std::vector<Material>& materials,
+                          const std::vector<MaterialTextures>& bindings,
+                          const std::vector<Texture>& textures);
 
 // The fingerprint stored in a checkpoint: FNV-1a 64 over the checkpoint version, the glint
 // version, the scene file's bytes, the geometry of every loaded mesh (positions, normals,
 // indices, texture coordinates, material index, emission: mesh files are not named in the Scene, so
 // their content is hashed as loaded), every material's values (a mesh file's materials too), the
-// pixels of every image texture and image background (likewise) and `settings`. A different value means the checkpoint belongs to another
-// render.
+// pixels of every image texture and image background (likewise) and `settings`. A different value
+// means the checkpoint belongs to another render.
 std::uint64_t renderFingerprint(std::string_view sceneFileBytes, const Scene& scene,
                                 const CheckpointSettings& settings);
 

@@ -218,6 +218,15 @@ TEST(Checkpoint, FingerprintCoversSceneBytesMeshesMaterialsAndEverySetting) {
   const Scene copper{parts};
   parts.materials[1].kd.g = 0.62;
   const Scene green{parts};
+  // The same texture as the diffuse or the specular map (an MTL's map_Kd or map_Ks).
+  parts.textures.push_back(CheckerTexture{});
+  parts.materialTextures.push_back(MaterialTextures{});
+  parts.materialTextures[0].kd = 0;
+  parts.materials[1].textures = 0;
+  const Scene diffuseMap{parts};
+  parts.materialTextures[0].kd = kNoTexture;
+  parts.materialTextures[0].ks = 0;
+  const Scene specularMap{parts};
 
   const CheckpointSettings s = sampleSettings();
   const std::uint64_t base = renderFingerprint("scene text", plain, s);
@@ -227,6 +236,8 @@ TEST(Checkpoint, FingerprintCoversSceneBytesMeshesMaterialsAndEverySetting) {
   EXPECT_NE(renderFingerprint("scene text", withMesh, s),
             renderFingerprint("scene text", movedMesh, s));
   EXPECT_NE(renderFingerprint("scene text", copper, s), renderFingerprint("scene text", green, s));
+  EXPECT_NE(renderFingerprint("scene text", diffuseMap, s),
+            renderFingerprint("scene text", specularMap, s));
   const auto changed = [&](auto change) {
     CheckpointSettings t = s;
     change(t);

@@ -126,8 +126,10 @@ PlyElementCounts checkPlyHeader(const std::string& header, std::uint64_t size) {
     // The keyword ends where assimp's PLY reader ends it: at a space or tab, or the line's end.
     // (istream's >> also stops at \v and \f; assimp then never sees its "end_header" and loops,
     // a fuzzing finding.)
-    const std::string keyword = line.substr(0, line.find_first_of(" \t"));
-    words.ignore(static_cast<std::streamsize>(keyword.size()));
+    // Leading blanks are skipped, as assimp skips them.
+    const std::size_t start = std::min(line.find_first_not_of(" \t"), line.size());
+    const std::string keyword = line.substr(start, line.find_first_of(" \t", start) - start);
+    words.ignore(static_cast<std::streamsize>(start + keyword.size()));
     if (keyword == "format") {
       std::string format;
       words >> format;

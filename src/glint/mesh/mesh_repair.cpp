@@ -560,12 +560,10 @@ void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
           : 0;
   const double epsilon = 1e-4 * diagonal;
 
-  // The distinct positions within epsilon of each (itself included): a grid of cells 16 epsilon
-  // wide, sorted by cell, each position looking in its own cell and the neighbours its epsilon
-  // ball reaches into.
-  std::vector<std::uint32_t> nearStart(positions + 1, 0);
-  std::vector<std::uint32_t> near;
-  near.reserve(positions);
+  // The distinct positions within epsilon of each (itself included), from a grid of cells 16
+  // epsilon wide sorted by cell: a position looks in its own cell and the neighbours its epsilon
+  // ball reaches into. Found one position at a time (a far outlier can make epsilon cover the
+  // whole model: then every position is near every other, and a stored list would be quadratic).
   const double cell = 16 * epsilon;
   // Cells along an axis: at most diagonal / cell + 1 = 626, so 21 bits each make a key.
   const auto cellOf = [&](double value, double origin) {
@@ -588,12 +586,13 @@ void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
     std::sort(byCell.begin(), byCell.end());
   }
   const double squaredEpsilon = epsilon * epsilon;
-  for (std::size_t p = 0; p < positions; ++p) {
+  std::vector<std::uint32_t> near;
+  const auto findNear = [&](std::size_t p) {
+    near.clear();
     const Double3 q = toDouble(vertices[firstVertex[p]]);
     if (!grid || !isFinite(q)) {
       near.push_back(static_cast<std::uint32_t>(p));
-      nearStart[p + 1] = static_cast<std::uint32_t>(near.size());
-      continue;
+      return;
     }
     const std::int64_t c[3] = {cellOf(q.x, lo.x), cellOf(q.y, lo.y), cellOf(q.z, lo.z)};
     const double at[3] = {q.x - lo.x, q.y - lo.y, q.z - lo.z};
@@ -619,37 +618,38 @@ void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
         }
       }
     }
-    nearStart[p + 1] = static_cast<std::uint32_t>(near.size());
-  }
+  };
 
   // Each vertex: the sum of the face normals within the crease angle at positions within epsilon.
   const double cosLimit = std::cos(creaseDegrees * std::numbers::pi / 180);
   if (mesh.mNormals == nullptr) mesh.mNormals = new aiVector3D[n];
-  for (std::size_t v = 0; v < n; ++v) {
-    if (faceOf[v] == kNone) {
-      mesh.mNormals[v] = aiVector3D(std::numeric_limits<float>::quiet_NaN());
-      continue;
-    }
-    const Double3 own = faceNormal[faceOf[v]];
-    Double3 sum;
-    const std::uint32_t p = positionOf[v];
-    for (std::uint32_t k = nearStart[p]; k < nearStart[p + 1]; ++k) {
-      const std::uint32_t other = near[k];
-      for (std::uint32_t j = rowStart[other]; j < rowStart[other + 1]; ++j) {
-        const std::uint32_t w = verticesAt[j];
-        if (faceOf[w] == kNone) continue;
-        const Double3& normal = faceNormal[faceOf[w]];
-        if (w != v && !(normal.x * own.x + normal.y * own.y + normal.z * own.z >= cosLimit)) {
-          continue;
-        }
-        sum = {sum.x + normal.x, sum.y + normal.y, sum.z + normal.z};
+  for (std::size_t p = 0; p < positions; ++p) {
+    findNear(p);
+    for (std::uint32_t i = rowStart[p]; i < rowStart[p + 1]; ++i) {
+      const std::uint32_t v = verticesAt[i];
+      if (faceOf[v] == kNone) {
+        mesh.mNormals[v] = aiVector3D(std::numeric_limits<float>::quiet_NaN());
+        continue;
       }
+      const Double3 own = faceNormal[faceOf[v]];
+      Double3 sum;
+      for (const std::uint32_t other : near) {
+        for (std::uint32_t j = rowStart[other]; j < rowStart[other + 1]; ++j) {
+          const std::uint32_t w = verticesAt[j];
+          if (faceOf[w] == kNone) continue;
+          const Double3& normal = faceNormal[faceOf[w]];
+          if (w != v && !(normal.x * own.x + normal.y * own.y + normal.z * own.z >= cosLimit)) {
+            continue;
+          }
+          sum = {sum.x + normal.x, sum.y + normal.y, sum.z + normal.z};
+        }
+      }
+      const double length = std::sqrt(sum.x * sum.x + sum.y * sum.y + sum.z * sum.z);
+      const double scale = length > 0 ? 1 / length : 1;
+      mesh.mNormals[v] =
+          aiVector3D(static_cast<float>(sum.x * scale), static_cast<float>(sum.y * scale),
+                     static_cast<float>(sum.z * scale));
     }
-    const double length = std::sqrt(sum.x * sum.x + sum.y * sum.y + sum.z * sum.z);
-    const double scale = length > 0 ? 1 / length : 1;
-    mesh.mNormals[v] =
-        aiVector3D(static_cast<float>(sum.x * scale), static_cast<float>(sum.y * scale),
-                   static_cast<float>(sum.z * scale));
   }
 }
 

@@ -37,7 +37,8 @@ void splitSharedCorners(aiScene& scene);
 
 // Vertex normals for a mesh without them (after splitSharedCorners and assimp's triangulation), as
 // assimp's GenSmoothNormals step defines them but in O(n) instead of its spatial sort's O(n^1.5)
-// (7.5 s of a 1M-triangle file's load): each vertex first takes the unit normal of the last face
+// (7.5 s of a 1M-triangle file's load; both are quadratic when epsilon spans most positions, as
+// one far outlier makes it): each vertex first takes the unit normal of the last face
 // that uses it (p1 − p0) × (p_last − p0); then its normal is the normalised sum of those normals
 // over the vertices within epsilon of its position (1e-4 of the mesh's bounding-box diagonal)
 // whose normal lies within `creaseDegrees` of its own (itself always). Vertices within epsilon are

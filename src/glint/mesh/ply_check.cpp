@@ -169,18 +169,22 @@ std::optional<PlyFault> asciiFault(std::string_view file, const Header& header) 
   };
   for (const Element& element : header.elements) {
     for (std::uint64_t i = 0; i < element.count; ++i) {
-      // The instance's line: the next one that is not blank.
-      bool found = false;
-      while (!found && readLine()) {
-        while (cursor < lineEnd && isBlank(file[cursor])) ++cursor;
-        found = cursor < lineEnd;
-      }
-      if (!found) {
+      // The instance's line. A blank one is a fault: assimp reads some blank lines as an
+      // instance of zeros and skips others, shifting every later line.
+      if (!readLine()) {
         return PlyFault{line + 1, 1,
                         fmt::format("the file ends before {} (the header declares {} '{}' "
                                     "elements): it is cut short, or the count is too large",
                                     instanceName(element, i), element.count, element.name)};
       }
+      while (cursor < lineEnd && isBlank(file[cursor])) ++cursor;
+      if (cursor == lineEnd) {
+        return PlyFault{line, 1,
+                        fmt::format("a blank line where {} should be: the mesh library would "
+                                    "read it as one, or skip it, and shift the lines after it",
+                                    instanceName(element, i))};
+      }
+      cursor = lineStart;
       const auto shortLine = [&](const std::string& needs) {
         std::size_t end = lineEnd;
         if (end > lineStart && file[end - 1] == '\r') --end;
@@ -225,10 +229,10 @@ std::optional<PlyFault> asciiFault(std::string_view file, const Header& header) 
       }
     }
   }
-  // After the last instance: blank lines only.
+  // After the last instance: blank lines (and NUL padding) only.
   while (readLine()) {
     const std::string_view extra = nextToken();
-    if (!extra.empty()) {
+    if (!extra.empty() && extra.find_first_not_of('\0') != std::string_view::npos) {
       return PlyFault{line, columnOf(extra),
                       "more data after the last element the header declares: the file holds "
                       "more than the header's counts say"};
@@ -264,13 +268,10 @@ std::optional<PlyFault> binaryFault(std::string_view file, const Header& header)
       fixedBytes += p.type.bytes;
     }
     if (fixed) {
-      // Counts and sizes are small enough here not to overflow: checkPlyHeader refused counts the
-      // file's size cannot hold.
-      const std::uint64_t needed = fixedBytes * element.count;
-      if (size - at < needed) {
-        return cutShort(element, fixedBytes == 0 ? 0 : (size - at) / fixedBytes);
+      if (fixedBytes != 0 && (size - at) / fixedBytes < element.count) {
+        return cutShort(element, (size - at) / fixedBytes);
       }
-      at += needed;
+      at += fixedBytes * element.count;
       continue;
     }
     for (std::uint64_t i = 0; i < element.count; ++i) {
@@ -293,7 +294,9 @@ std::optional<PlyFault> binaryFault(std::string_view file, const Header& header)
       }
     }
   }
-  if (at < size) {
+  // Whitespace and NUL padding after the last instance are allowed (a final newline).
+  const std::string_view rest = file.substr(static_cast<std::size_t>(at));
+  if (rest.find_first_not_of(std::string_view(" \t\r\n\0", 5)) != std::string_view::npos) {
     return PlyFault{0, 0,
                     fmt::format("{} bytes after the last element the header declares (from byte "
                                 "{}): the file holds more than the header's counts say",

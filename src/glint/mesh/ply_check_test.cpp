@@ -30,9 +30,12 @@ std::string faultAt(const std::string& file) {
 
 TEST(PlyCheck, AnAsciiBodyAsTheHeaderSaysPasses) {
   EXPECT_EQ(faultAt(header("ascii", 4, 2) + kSquare + "3 0 1 2\n3 0 2 3\n"), "none");
-  // Blank lines, CRLF, tabs, trailing blanks, a missing last newline, numbers in every spelling.
-  EXPECT_EQ(faultAt(header("ascii", 4, 2) + "\n-1 -1 0\r\n1\t-1 0  \n\n+1 1.0 .0\n-1e0 1 nan\n" +
+  // CRLF, tabs, trailing blanks, a missing last newline, numbers in every spelling.
+  EXPECT_EQ(faultAt(header("ascii", 4, 2) + "-1 -1 0\r\n1\t-1 0  \n+1 1.0 .0\n-1e0 1 nan\n" +
                     "4 0 1 2 3\n3 0 2 3"),
+            "none");
+  // Blank lines and NUL padding after the last element.
+  EXPECT_EQ(faultAt(header("ascii", 4, 1) + kSquare + "3 0 1 2\n\n  \r\n" + std::string(3, '\0')),
             "none");
   EXPECT_EQ(faultAt(header("ascii", 4, 1) + kSquare + "0\n"), "none");  // an empty list
 }
@@ -45,6 +48,13 @@ TEST(PlyCheck, AnAsciiBodyThatDisagreesIsAFaultAtItsPlace) {
   EXPECT_EQ(faultAt(header("ascii", 4, 1) + kSquare + "3 0 1 2\n3 0 2 3\n"),
             "16:1 more data after the last element the header declares: the file holds more "
             "than the header's counts say");
+  // A blank line among the elements: assimp read some as an element of zeros and skipped
+  // others, shifting the lines after it.
+  EXPECT_EQ(faultAt(header("ascii", 4, 1) + "-1 -1 0\n\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n"),
+            "12:1 a blank line where 'vertex' 2 of 4 should be: the mesh library would read it as "
+            "one, or skip it, and shift the lines after it");
+  EXPECT_EQ(faultAt(header("ascii", 4, 1) + "  \r\n" + kSquare + "3 0 1 2\n").substr(0, 21),
+            "11:1 a blank line whe");
   EXPECT_EQ(faultAt(header("ascii", 4, 1) + "-1 -1\n"),
             "11:6 the line of 'vertex' 1 of 4 ends early: no value for 'z' (the header's "
             "properties: x y z)");
@@ -98,6 +108,8 @@ TEST(PlyCheck, ABinaryBodyIsWalkedToItsEnd) {
               "0:0 the file ends at byte " + std::to_string(cut.size()) +
                   " within 'face' 2 of 2 (the header declares 2 'face' elements): it is cut "
                   "short, or the count is too large");
+    EXPECT_EQ(faultAt(file + "\n"), "none");  // a final newline, or NUL padding
+    EXPECT_EQ(faultAt(file + std::string(4, '\0')), "none");
     EXPECT_EQ(faultAt(file + "xy"),
               "0:0 2 bytes after the last element the header declares (from byte " +
                   std::to_string(file.size()) +
@@ -114,6 +126,18 @@ TEST(PlyCheck, ABinaryBodyIsWalkedToItsEnd) {
             "0:0 the file ends at byte " + std::to_string(shortVertices.size()) +
                 " within 'vertex' 4 of 4 (the header declares 4 'vertex' elements): it is cut "
                 "short, or the count is too large");
+}
+
+// A count whose size in bytes overflows 64 bits is cut short, not wrapped around (a header line
+// with a leading blank, which the header check once did not read, declared it).
+TEST(PlyCheck, ACountTooLargeForTheFileIsCutShortWhateverItsSize) {
+  const std::string file =
+      "ply\nformat binary_little_endian 1.0\n element vertex 6148914691236517206\nproperty uchar "
+      "x\nproperty uchar y\nproperty uchar z\nend_header\nab";
+  EXPECT_EQ(faultAt(file), "0:0 the file ends at byte " + std::to_string(file.size()) +
+                               " within 'vertex' 1 of 6148914691236517206 (the header declares "
+                               "6148914691236517206 'vertex' elements): it is cut short, or the "
+                               "count is too large");
 }
 
 TEST(PlyCheck, TriangleStripsAreRefused) {

@@ -37,8 +37,9 @@ class Words {
   }
 
  private:
+  // NUL too: exporters pad files with NULs after endsolid.
   static bool isSpace(char c) {
-    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
+    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v' || c == '\0';
   }
   void advance() {
     if (text_[at_] == '\n') {

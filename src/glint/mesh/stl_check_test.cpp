@@ -31,6 +31,7 @@ TEST(StlCheck, WellFormedSolidsPass) {
                     "endfacet\n"),
             "none");                         // no normal, no endsolid
   EXPECT_EQ(faultAt("not an stl"), "none");  // not ASCII STL: the mesh library says so
+  EXPECT_EQ(faultAt("solid\n" + kFacet + "endsolid\n" + std::string(20, '\0')), "none");  // padding
 }
 
 TEST(StlCheck, MalformedStatementsAreFaultsAtTheirPlace) {
