@@ -519,16 +519,28 @@ void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
   std::vector<std::uint32_t> slot(slots, kNone);
   std::vector<std::uint32_t> positionOf(n);
   std::vector<std::uint32_t> firstVertex;  // of each distinct position
-  for (std::size_t v = 0; v < n; ++v) {
-    std::size_t at = static_cast<std::size_t>(positionHash(vertices[v]) % slots);
-    while (slot[at] != kNone && !samePosition(vertices[firstVertex[slot[at]]], vertices[v])) {
-      at = at + 1 == slots ? 0 : at + 1;
+  // In batches whose table slots are requested from memory before the first is probed: the
+  // probes are cache misses, and waiting for them one by one was most of this function's time.
+  constexpr std::size_t kBatch = 32;
+  std::size_t home[kBatch];
+  for (std::size_t begin = 0; begin < n; begin += kBatch) {
+    const std::size_t count = std::min(kBatch, n - begin);
+    for (std::size_t k = 0; k < count; ++k) {
+      home[k] = static_cast<std::size_t>(positionHash(vertices[begin + k]) % slots);
+      __builtin_prefetch(&slot[home[k]]);
     }
-    if (slot[at] == kNone) {
-      slot[at] = static_cast<std::uint32_t>(firstVertex.size());
-      firstVertex.push_back(static_cast<std::uint32_t>(v));
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::size_t v = begin + k;
+      std::size_t at = home[k];
+      while (slot[at] != kNone && !samePosition(vertices[firstVertex[slot[at]]], vertices[v])) {
+        at = at + 1 == slots ? 0 : at + 1;
+      }
+      if (slot[at] == kNone) {
+        slot[at] = static_cast<std::uint32_t>(firstVertex.size());
+        firstVertex.push_back(static_cast<std::uint32_t>(v));
+      }
+      positionOf[v] = slot[at];
     }
-    positionOf[v] = slot[at];
   }
   slot = {};
   const std::size_t positions = firstVertex.size();
