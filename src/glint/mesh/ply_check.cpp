@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "glint/mesh/file_fault.h"
+#include "glint/readers/diagnostics.h"
 
 namespace glint {
 namespace {
@@ -122,14 +123,6 @@ std::string instanceName(const Element& element, std::uint64_t i) {
   return fmt::format("'{}' {} of {}", element.name, i + 1, element.count);
 }
 
-std::string quoted(std::string_view token) {
-  std::string out;
-  for (const char c : token.substr(0, 40)) {
-    out.push_back(static_cast<unsigned char>(c) >= 0x20 && c != 0x7f ? c : '?');
-  }
-  return "'" + out + (token.size() > 40 ? "...'" : "'");
-}
-
 // A list's count: a whole number within its type (no sign for an unsigned type).
 std::optional<std::uint64_t> listCount(std::string_view token, const PlyType& type) {
   if (!token.empty() && token[0] == '+') token.remove_prefix(1);
@@ -194,8 +187,8 @@ std::optional<PlyFault> asciiFault(std::string_view file, const Header& header) 
       };
       const auto notANumber = [&](std::string_view token, const Property& property) {
         return PlyFault{line, columnOf(token),
-                        fmt::format("{} is not a number ('{}' of {})", quoted(token), property.name,
-                                    instanceName(element, i))};
+                        fmt::format("{} is not a number ('{}' of {})", quoteForMessage(token),
+                                    property.name, instanceName(element, i))};
       };
       for (const Property& property : element.properties) {
         std::string_view token = nextToken();
@@ -206,10 +199,11 @@ std::optional<PlyFault> asciiFault(std::string_view file, const Header& header) 
         }
         const std::optional<std::uint64_t> count = listCount(token, property.countType);
         if (!count) {
-          return PlyFault{line, columnOf(token),
-                          fmt::format("{} is not a count of '{}' values for {} (a whole number "
-                                      "of the count's type)",
-                                      quoted(token), property.name, instanceName(element, i))};
+          return PlyFault{
+              line, columnOf(token),
+              fmt::format("{} is not a count of '{}' values for {} (a whole number "
+                          "of the count's type)",
+                          quoteForMessage(token), property.name, instanceName(element, i))};
         }
         for (std::uint64_t k = 0; k < *count; ++k) {
           token = nextToken();

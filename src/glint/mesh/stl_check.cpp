@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "glint/mesh/file_fault.h"
+#include "glint/readers/diagnostics.h"
 
 namespace glint {
 namespace {
@@ -55,14 +56,6 @@ class Words {
   std::size_t lineStart_ = 0;
 };
 
-std::string quoted(std::string_view word) {
-  std::string out;
-  for (const char c : word.substr(0, 40)) {
-    out.push_back(static_cast<unsigned char>(c) >= 0x20 && c != 0x7f ? c : '?');
-  }
-  return "'" + out + (word.size() > 40 ? "...'" : "'");
-}
-
 StlFault faultAt(const Words::Word& word, std::string what) {
   return StlFault{word.line, word.column, std::move(what)};
 }
@@ -99,8 +92,8 @@ std::optional<StlFault> findStlFault(std::string_view file) {
         return faultAt(number, fmt::format("the file ends within a {} (3 numbers)", owner));
       }
       if (!isNumberWord(number.text)) {
-        return faultAt(number,
-                       fmt::format("{} is not a number (a {} has 3)", quoted(number.text), owner));
+        return faultAt(number, fmt::format("{} is not a number (a {} has 3)",
+                                           quoteForMessage(number.text), owner));
       }
     }
     return std::nullopt;
@@ -113,7 +106,8 @@ std::optional<StlFault> findStlFault(std::string_view file) {
       return faultAt(got,
                      fmt::format("the file ends {}, before '{}' (cut short?)", where, keyword));
     }
-    return faultAt(got, fmt::format("expected '{}' {}, got {}", keyword, where, quoted(got.text)));
+    return faultAt(
+        got, fmt::format("expected '{}' {}, got {}", keyword, where, quoteForMessage(got.text)));
   };
   while (true) {
     // In a solid: its name, then facets until endsolid.
@@ -123,8 +117,8 @@ std::optional<StlFault> findStlFault(std::string_view file) {
       if (word.text.empty()) return std::nullopt;  // no endsolid: assimp takes the facets read
       if (is(word, "endsolid")) break;
       if (!is(word, "facet")) {
-        return faultAt(word,
-                       fmt::format("expected 'facet' or 'endsolid', got {}", quoted(word.text)));
+        return faultAt(word, fmt::format("expected 'facet' or 'endsolid', got {}",
+                                         quoteForMessage(word.text)));
       }
       const Words::Word facet = word;
       word = words.next();
@@ -132,9 +126,9 @@ std::optional<StlFault> findStlFault(std::string_view file) {
         if (auto fault = numbers("normal")) return fault;
         if (auto fault = expect("outer", "in a facet")) return fault;
       } else if (!is(word, "outer")) {
-        return faultAt(word,
-                       fmt::format("expected 'normal' or 'outer' in a facet, got {}",
-                                   word.text.empty() ? "the end of the file" : quoted(word.text)));
+        return faultAt(word, fmt::format("expected 'normal' or 'outer' in a facet, got {}",
+                                         word.text.empty() ? "the end of the file"
+                                                           : quoteForMessage(word.text)));
       }
       if (auto fault = expect("loop", "after 'outer'")) return fault;
       int vertices = 0;
@@ -145,8 +139,8 @@ std::optional<StlFault> findStlFault(std::string_view file) {
           if (word.text.empty()) {
             return faultAt(word, "the file ends within a facet, before 'endloop' (cut short?)");
           }
-          return faultAt(word,
-                         fmt::format("expected 'vertex' or 'endloop', got {}", quoted(word.text)));
+          return faultAt(word, fmt::format("expected 'vertex' or 'endloop', got {}",
+                                           quoteForMessage(word.text)));
         }
         if (++vertices > 3) {
           return faultAt(word,
@@ -166,7 +160,7 @@ std::optional<StlFault> findStlFault(std::string_view file) {
     if (word.text.empty()) return std::nullopt;
     if (!is(word, "solid")) {
       return faultAt(word, fmt::format("expected 'solid' or the end after 'endsolid', got {}",
-                                       quoted(word.text)));
+                                       quoteForMessage(word.text)));
     }
   }
 }
