@@ -77,7 +77,9 @@ bool hasErrors(const std::vector<Diagnostic>& diagnostics) {
 }
 
 std::string Diagnostic::format() const {
-  std::string out = where.file;
+  // The file's name as the user gave it, but never a control byte or invalid UTF-8 raw on the
+  // terminal (a name holding an escape sequence could recolour or rewrite it).
+  std::string out = escapeForMessage(where.file);
   if (where.line > 0) {
     out += ':' + std::to_string(where.line);
     if (where.column > 0) out += ':' + std::to_string(where.column);
