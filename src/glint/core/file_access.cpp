@@ -112,11 +112,13 @@ fs::path lexicalPath(const fs::path& path) {
   return (error ? path : absolute).lexically_normal();
 }
 
-// Symbolic links resolved as far as the path exists, the rest lexically.
+// Symbolic links resolved as far as the path exists, the rest lexically; absolute (weakly_canonical
+// of a relative path none of whose parts exist stays relative, and then lay "outside" any root).
 fs::path resolvedPath(const fs::path& path) {
   std::error_code error;
-  const fs::path resolved = fs::weakly_canonical(path, error);
-  return error ? lexicalPath(path) : resolved;
+  const fs::path absolute = lexicalPath(path);
+  const fs::path resolved = fs::weakly_canonical(absolute, error);
+  return error ? absolute : resolved;
 }
 
 // The folder itself, without the empty last element a trailing '/' leaves.

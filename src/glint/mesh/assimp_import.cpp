@@ -84,7 +84,7 @@ class MeshFileAccess : public Assimp::DefaultIOSystem {
   // The file opened for reading when the rules allow it (else fd −1, the refusal kept).
   ReadableFile openChecked(const char* file) {
     ReadableFile opened;
-    if (refused(rule_.refusal(file))) return opened;
+    if (breaksRule(file)) return opened;
     opened = openForReading(file);
     if (!accepted(file, opened) || refused(rule_.openedRefusal(opened.fd, file))) {
       return ReadableFile();
@@ -93,13 +93,23 @@ class MeshFileAccess : public Assimp::DefaultIOSystem {
   }
   // DefaultIOSystem::Exists opens the file with fopen, which blocks on a FIFO.
   bool Exists(const char* file) const override {
-    return file != nullptr && !refused(rule_.refusal(file)) && accepted(file, statForReading(file));
+    return file != nullptr && !breaksRule(file) && accepted(file, statForReading(file));
   }
 
   // Why a file the mesh file names refuses it ("" when none did), in the user's words.
   const std::string& refusal() const { return refusal_; }
 
  private:
+  // Whether the rules forbid reading `file`; the refusal is kept only when the file exists.
+  // Importers probe names that are not the file a mesh names (assimp's glTF importer joins the
+  // mesh's folder twice, "../../x.bin" for "../m.gltf"), and a name that leads nowhere reads
+  // nothing: a missing buffer is then the importer's "could not open", not a refusal.
+  bool breaksRule(const char* file) const {
+    const std::string why = rule_.refusal(file);
+    if (why.empty()) return false;
+    if (statForReading(file).refusal != FileRefusal::Missing) refused(why);
+    return true;
+  }
   // Keeps the first refusal; true when `why` is one.
   bool refused(const std::string& why) const {
     if (!why.empty() && refusal_.empty()) refusal_ = why;

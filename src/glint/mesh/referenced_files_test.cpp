@@ -85,6 +85,21 @@ TEST_F(MeshReferencedFiles, AGltfBufferOutsideTheSceneFolderIsRefusedNamingIt) {
             fs::file_size(mesh) / 12);
 }
 
+// A buffer that does not exist is the importer's "could not open", whatever names it probes for
+// it: given as "../m.gltf" from a subfolder, assimp's glTF importer also tries "../../x.bin"
+// (its folder joined twice), which lies outside; that probe read nothing and refused the file as
+// if it named a file outside. Checked from inside a subfolder of the scene.
+TEST_F(MeshReferencedFiles, AMissingBufferIsNotFoundNotRefused) {
+  write("missing.gltf", triangleGltf("nothere.bin"));
+  const fs::path before = fs::current_path();
+  fs::current_path(scene_ / "models");
+  const std::string reason = reasonIn("../missing.gltf", "..");
+  const std::string plain = reasonIn("../missing.gltf", "");
+  fs::current_path(before);
+  EXPECT_THAT(reason, HasSubstr("could not open referenced file \"nothere.bin\""));
+  EXPECT_THAT(plain, HasSubstr("could not open referenced file \"nothere.bin\""));
+}
+
 TEST_F(MeshReferencedFiles, ASymbolicLinkLeadingOutsideIsRefused) {
   fs::create_symlink(dir_.path() / "outside.bin", scene_ / "link.bin");
   fs::create_directory_symlink(dir_.path(), scene_ / "up");
