@@ -28,7 +28,8 @@ using PlyFault = MeshFileFault;
 //    count type. A body that ends before the last instance, a negative list count, or bytes after
 //    the last instance other than whitespace and NUL padding are faults (at their byte offset,
 //    said in `what`).
-// A `tristrips` element is a fault: glint does not read triangle strips from PLY files.
+// A `tristrips` element is a fault: glint does not read triangle strips from PLY files; so is an
+// element of a non-zero count that has no properties.
 std::optional<PlyFault> findPlyFault(std::string_view file);
 
 }  // namespace glint

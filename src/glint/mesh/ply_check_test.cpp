@@ -140,6 +140,16 @@ TEST(PlyCheck, ACountTooLargeForTheFileIsCutShortWhateverItsSize) {
                                "count is too large");
 }
 
+TEST(PlyCheck, AnElementWithoutPropertiesIsRefused) {
+  EXPECT_EQ(
+      faultAt("ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nend_header\n"),
+      "0:0 its header declares 4000000000 'vertex' elements without any property");
+  EXPECT_EQ(faultAt("ply\nformat ascii 1.0\nelement nothing 0\n" +
+                    header("ascii", 4, 1).substr(std::string("ply\nformat ascii 1.0\n").size()) +
+                    kSquare + "3 0 1 2\n"),
+            "none");  // declared empty: allowed
+}
+
 TEST(PlyCheck, TriangleStripsAreRefused) {
   EXPECT_EQ(faultAt(header("ascii", 4, 1, "tristrips") + kSquare + "4 0 1 2 3\n"),
             "0:0 it holds triangle strips (element 'tristrips'), which glint does not read from "
