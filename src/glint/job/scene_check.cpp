@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <new>
@@ -117,8 +118,21 @@ SceneFacts sceneFacts(const Scene& scene) {
 }
 
 std::optional<Diagnostic> pixelWorkWarning(const std::string& file, const SceneParts& parts) {
+  // The path integrator's next-event rays: toward the emitters, when something glows, and toward
+  // an image sky.
+  const auto glows = [](const Color& emission) { return !isBlack(emission); };
+  bool emitters = std::any_of(parts.meshes.begin(), parts.meshes.end(),
+                              [&](const TriangleMesh& m) { return glows(m.emission); }) ||
+                  std::any_of(parts.primitives.begin(), parts.primitives.end(),
+                              [&](const Primitive& p) { return glows(p.emission()); });
+  for (const GroupParts& group : parts.groups) {
+    for (const Primitive& p : group.primitives) emitters = emitters || glows(p.emission());
+    for (const TriangleMesh& m : group.meshes) emitters = emitters || glows(m.emission);
+  }
+  const int pathLightRays =
+      (emitters ? 1 : 0) + (parts.environment.kind == BackgroundKind::Image ? 1 : 0);
   const PixelWork work =
-      estimatePixelWork(parts.image, parts.render, parts.lights, parts.materials);
+      estimatePixelWork(parts.image, parts.render, parts.lights, parts.materials, pathLightRays);
   const double rays = work.raysPerPixel();
   if (!(rays > kAbsurdRaysPerPixel)) return std::nullopt;
   const double perHit =

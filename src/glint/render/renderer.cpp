@@ -1529,7 +1529,7 @@ SamplesPerPixel samplesPerPixel(const ImageSettings& image) {
 
 PixelWork estimatePixelWork(const ImageSettings& image, const RenderSettings& render,
                             const std::vector<Light>& lights,
-                            const std::vector<Material>& materials) {
+                            const std::vector<Material>& materials, int pathLightRays) {
   PixelWork work;
   work.samples = static_cast<std::uint64_t>(samplesPerPixel(image).maximum);
   for (const Light& light : lights) {
@@ -1566,6 +1566,7 @@ PixelWork estimatePixelWork(const ImageSettings& image, const RenderSettings& re
     work.depth = std::max(render.maxDepth, 1);
     work.hitsPerSample = work.depth;
     work.glossyRaysPerHit = 1;
+    work.shadowRaysPerHit += static_cast<std::uint64_t>(std::max(pathLightRays, 0));
   }
   return work;
 }

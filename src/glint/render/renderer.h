@@ -95,17 +95,20 @@ struct PixelWork {
   int depth = 1;                       // surface hits along one path (max_depth, cut by min_weight)
   double hitsPerSample = 1;            // depth, or 2^depth − 1 when some material both reflects
                                        // and transmits (every such hit forks the path)
-  std::uint64_t shadowRaysPerHit = 0;  // one per light, `samples` per area light, and the
-                                       // ambient occlusion rays
+  std::uint64_t shadowRaysPerHit = 0;  // one per light, `samples` per area light, the
+                                       // ambient occlusion rays, the path integrator's
+                                       // next-event rays
   std::uint64_t glossyRaysPerHit = 0;  // blur_samples when some material is glossy, else 0
   double raysPerPixel() const {
     return static_cast<double>(samples) * hitsPerSample *
            (1 + static_cast<double>(shadowRaysPerHit) + static_cast<double>(glossyRaysPerHit));
   }
 };
+// `pathLightRays`: the path integrator's next-event rays at each hit besides the lights' — one
+// toward the emissive objects and one toward an image sky, where the scene has them.
 PixelWork estimatePixelWork(const ImageSettings& image, const RenderSettings& render,
                             const std::vector<Light>& lights,
-                            const std::vector<Material>& materials);
+                            const std::vector<Material>& materials, int pathLightRays = 0);
 
 // The tiles a render of `region` is cut into, in the order render() numbers them: row-major from
 // the region's top-left corner, tileSize × tileSize pixels, clipped at the right and bottom edges.

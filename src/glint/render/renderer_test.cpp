@@ -795,6 +795,13 @@ TEST(Renderer, PixelWorkCountsSamplesLightsGlossAndDepth) {
   parts.image.adaptive = AdaptiveSampling{128, 0.02};
   EXPECT_EQ(estimatePixelWork(parts.image, parts.render, parts.lights, parts.materials).samples,
             128u);
+  // The path integrator: one path of max_depth hits, one ray on from each, and its next-event
+  // rays toward emitters and an image sky besides the lights' shadow rays.
+  parts.render.integrator = Integrator::Path;
+  work = estimatePixelWork(parts.image, parts.render, parts.lights, parts.materials, 2);
+  EXPECT_DOUBLE_EQ(work.hitsPerSample, 20);
+  EXPECT_EQ(work.shadowRaysPerHit, 65536u + 1u + 2u);
+  EXPECT_EQ(work.glossyRaysPerHit, 1u);
 }
 
 }  // namespace
