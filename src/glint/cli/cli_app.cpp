@@ -30,6 +30,7 @@
 #include "glint/cli/signal_guard.h"
 #include "glint/core/isa.h"
 #include "glint/job/job_error.h"
+#include "glint/job/output_paths.h"
 #include "glint/job/render_job.h"
 #include "glint/job/scene_check.h"
 #include "glint/job/scene_convert.h"
@@ -453,6 +454,14 @@ int renderAndReport(RenderJobSpec spec, const RenderArgs& args, SignalGuard& sig
   events.committing = [&signals](bool committing) { signals.setCommitting(committing); };
   std::optional<PreviewSession> preview;
   if (args.preview) {
+    // An output path the job would refuse is said before the preview's address (no page for a
+    // render that never starts).
+    try {
+      checkOutputPath(spec.output.empty() ? defaultOutputPath(spec.scene) : spec.output,
+                      spec.sceneParts ? std::filesystem::path() : spec.scene, spec.resume);
+    } catch (const JobError& error) {
+      return reportJobError(error, args.scene);
+    }
     try {
       preview.emplace(*args.preview, args.scene, stderr);
     } catch (const PreviewError& error) {
