@@ -7,6 +7,7 @@
 #include <netinet/in.h>
 #include <sys/socket.h>
 
+#include <atomic>
 #include <regex>
 
 #include "cli_harness.h"
@@ -49,6 +50,59 @@ TEST(PreviewJob, TheLastPictureIsTheWrittenPng) {
                   &tile.rgb[static_cast<std::size_t>(y - tile.region.y0) * tile.region.width() * 3],
                   static_cast<std::size_t>(tile.region.width()) * 3);
   EXPECT_TRUE(shown == png.rgb) << "the preview's picture differs from the PNG";
+  fs::remove_all(folder);
+}
+
+// A resumed render's preview shows the checkpoint's tiles when the render starts, not only with
+// the finished image: by the first newly rendered tile, every resumed tile is on the page.
+TEST(PreviewJob, AResumedRenderShowsItsCheckpointsTilesAtOnce) {
+  const fs::path folder =
+      fs::temp_directory_path() / ("glint-preview-resume-" + std::to_string(getpid()));
+  fs::create_directories(folder);
+  const fs::path scene = fs::path(GLINT_SOURCE_DIR) / "scenes" / "first-scene.yaml";
+  // Half the tiles, then stop: the checkpoint holds them.
+  std::atomic<bool> stop{false};
+  glint::RenderJobSpec first;
+  first.scene = scene;
+  first.overrides.width = 160;
+  first.threads = 1;
+  first.output = folder / "out.png";
+  first.checkpoint = folder / "run.ckpt";
+  first.cancel = &stop;
+  glint::RenderJobEvents stopHalfway;
+  stopHalfway.progress = [&stop](std::size_t done, std::size_t total) {
+    if (2 * done >= total) stop = true;
+  };
+  const glint::RenderJobResult interrupted = glint::runRenderJob(first, stopHalfway);
+  ASSERT_EQ(interrupted.outcome, glint::RenderJobResult::Outcome::Interrupted);
+  ASSERT_GT(interrupted.tilesSaved, 0u);
+
+  glint::PreviewState state("resume");
+  glint::RenderJobSpec second = first;
+  second.cancel = nullptr;
+  second.resume = folder / "run.ckpt";
+  glint::RenderJobEvents events;
+  glint::attachPreview(events, state);
+  std::size_t shownAtFirstTile = 0;
+  bool firstTile = true;
+  events.progress = [&, before = events.progress](std::size_t done, std::size_t total) {
+    if (firstTile) {
+      firstTile = false;
+      // The preview publishes on its own thread: wait for it (a bound, not a race).
+      const auto deadline = std::chrono::steady_clock::now() + 10s;
+      glint::PreviewChanges changes = state.waitForChanges(0, 0ms);
+      while (changes.tiles.size() < interrupted.tilesSaved &&
+             std::chrono::steady_clock::now() < deadline)
+        changes = state.waitForChanges(0, 50ms);
+      shownAtFirstTile = changes.tiles.size();
+    }
+    if (before) before(done, total);
+  };
+  const glint::RenderJobResult resumed = glint::runRenderJob(second, events);
+  state.ended(glint::PreviewPhase::Finished, "done");
+  ASSERT_EQ(resumed.outcome, glint::RenderJobResult::Outcome::Written);
+  EXPECT_EQ(resumed.tilesResumed, interrupted.tilesSaved);
+  EXPECT_GE(shownAtFirstTile, interrupted.tilesSaved);
   fs::remove_all(folder);
 }
 

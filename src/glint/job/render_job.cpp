@@ -224,6 +224,15 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
     };
   }
   if (events.renderStarting) events.renderStarting(tilesDone, tiles.size());
+  // The tiles a resumed checkpoint holds are final already: a preview shows them now, not with the
+  // finished image (a resume late in a long render would show almost nothing until the end).
+  if (resumed && events.tileFinished) {
+    for (std::size_t tile = 0; tile < tiles.size(); ++tile) {
+      if (!resumed->tiles[tile]) continue;
+      events.tileFinished(
+          FinishedTile{tile, tiles[tile], resumed->film, tilesDone, tiles.size(), std::nullopt});
+    }
+  }
   Film film(scene.image().width, scene.image().height, region);
   if (!spec.renderStep) {
     renderInto(scene, options, film, &result.stats);

@@ -77,6 +77,8 @@ struct FinishedTile {
 
 // What a caller hears while the job runs. Every callback is optional. They are called on the
 // thread that runs the job, except progress and tileFinished: from render threads, one at a time.
+// (tileFinished is also called for each tile a resumed checkpoint holds, on the job's thread,
+// after renderStarting and before the render.)
 struct RenderJobEvents {
   // The scene's warnings (FILE:LINE:COL), once it is loaded, before anything else is done.
   std::function<void(const std::vector<Diagnostic>&)> sceneWarnings;
