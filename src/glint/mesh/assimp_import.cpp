@@ -426,6 +426,17 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
     if (extension == ".obj") objDefined = mtlMaterialNames(*files, path.string());
     // The importer owns the scene and its steps edit it in place; so does dropInvalidFaces.
     result.droppedTriangles = dropInvalidFaces(const_cast<aiScene&>(*scene));
+    // A PLY face of one or two corners is a malformed polygon (PLY has no points or lines in its
+    // faces): dropped with the degenerate triangles and counted in their warning, where
+    // SortByPType would remove it silently (OBJ's and glTF's points and lines are meant so).
+    std::size_t malformedFaces = 0;
+    for (unsigned m = 0; extension == ".ply" && m < scene->mNumMeshes; ++m) {
+      const aiMesh* mesh = scene->mMeshes[m];
+      for (unsigned f = 0; mesh != nullptr && f < mesh->mNumFaces; ++f) {
+        const unsigned corners = mesh->mFaces[f].mNumIndices;
+        if (corners == 1 || corners == 2) ++malformedFaces;
+      }
+    }
     splitSharedCorners(const_cast<aiScene&>(*scene));
     // Before Triangulate, whose time grows with the square of a polygon's corners.
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
@@ -443,6 +454,7 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
                                             result.droppedTriangles)
                               : std::string("the file holds no triangles"));
     }
+    result.droppedTriangles += malformedFaces;
     scene = importer.ApplyPostProcessing(flags);
     if (scene == nullptr) throw MeshLoadError(assimpReason(importer.GetErrorString()));
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {

@@ -359,6 +359,26 @@ TEST(MeshRepair, FacesWithIndicesOutOfRangeAreDroppedAndCounted) {
   EXPECT_EQ(file.droppedTriangles, 2u);  // the quad with index 7 stood for two triangles
 }
 
+TEST(MeshRepair, PlyFacesOfOneOrTwoCornersAreDroppedAndCounted) {
+  // PLY has no points or lines among its faces: such a face is a malformed polygon, counted in
+  // the warning with the degenerate triangles (the mesh library's step removed it silently).
+  TempDir dir;
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 3\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n1 1 0\n";
+  const MeshFile file = readMeshFile(dir.write("short.ply", header + "3 0 1 2\n2 1 3\n1 3\n"));
+  EXPECT_EQ(file.triangleCount(), 1u);
+  EXPECT_EQ(file.droppedTriangles, 2u);
+  // Only such faces: no triangles, not "indices out of range".
+  try {
+    readMeshFile(dir.write("lines.ply", header + "2 0 1\n2 1 3\n2 3 0\n"));
+    FAIL() << "a PLY of two-corner faces loaded";
+  } catch (const MeshLoadError& e) {
+    EXPECT_STREQ(e.what(), "the file holds no triangles");
+  }
+}
+
 TEST(MeshRepair, InvalidFileNormalsAreRepairedFromTheFaces) {
   // A zero normal in the file (vn 0 0 0) is replaced by the mean of the faces around the vertex.
   TempDir dir;
