@@ -5,7 +5,6 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -17,9 +16,9 @@
 #include <fmt/format.h>
 
 #include "glint/mesh/assimp_import.h"
-#include "glint/mesh/format_checks.h"
 #include "glint/mesh/import_child.h"
 #include "glint/mesh/mesh_reader_wire.h"
+#include "glint/mesh/mesh_size_estimate.h"
 
 namespace glint {
 
@@ -60,49 +59,6 @@ namespace {
 #endif
 #endif
 
-#ifndef GLINT_READER_UNDER_ASAN
-// The bytes a .gltf brings: its own and those of the buffer files its `buffers` name (a data:
-// URI is inside it). A buffer that cannot be found adds nothing (assimp then fails on it).
-std::uintmax_t gltfBytes(const std::filesystem::path& file, std::uintmax_t own) {
-  std::string text;
-  {
-    std::FILE* in = std::fopen(file.c_str(), "rb");
-    if (in == nullptr) return own;
-    text.resize(static_cast<std::size_t>(own));
-    text.resize(std::fread(text.data(), 1, text.size(), in));
-    std::fclose(in);
-  }
-  std::uintmax_t total = own;
-  try {
-    const GltfJson json = parseGltfJson(text);
-    const ValueView buffers = json.root().find("buffers");
-    for (std::size_t i = 0; i < buffers.size(); ++i) {
-      const std::string_view uri = buffers[i].find("uri").scalar();
-      if (uri.empty() || uri.starts_with("data:")) continue;
-      // URIs are percent-encoded (RFC 3986).
-      std::string name;
-      for (std::size_t k = 0; k < uri.size(); ++k) {
-        if (uri[k] == '%' && k + 2 < uri.size() &&
-            std::isxdigit(static_cast<unsigned char>(uri[k + 1])) &&
-            std::isxdigit(static_cast<unsigned char>(uri[k + 2]))) {
-          name.push_back(
-              static_cast<char>(std::stoi(std::string(uri.substr(k + 1, 2)), nullptr, 16)));
-          k += 2;
-        } else {
-          name.push_back(uri[k]);
-        }
-      }
-      std::error_code error;
-      const std::uintmax_t size = std::filesystem::file_size(file.parent_path() / name, error);
-      if (!error) total += size;
-    }
-  } catch (const std::exception&) {
-    // Not JSON: assimp's words for it.
-  }
-  return total;
-}
-#endif
-
 // Caps this process's address space at what it uses now plus 512 MiB plus 256 bytes per byte of
 // the mesh file (for a .gltf, of it and its buffer files). assimp's ASCII PLY reader takes any
 // list count and reads zeros past the file's end: a 383-byte file's count of 44294967295 had it
@@ -112,12 +68,13 @@ std::uintmax_t gltfBytes(const std::filesystem::path& file, std::uintmax_t own) 
 // allowed). Not under AddressSanitizer, whose shadow memory reserves terabytes of address space
 // (the fuzzers bound the reader's time instead: setMeshReadTimeLimitForTesting).
 void capAddressSpace([[maybe_unused]] const std::filesystem::path& file,
-                     [[maybe_unused]] std::string_view extension) {
+                     [[maybe_unused]] std::string_view extension,
+                     [[maybe_unused]] const ReferencedFileRule& rule) {
 #ifndef GLINT_READER_UNDER_ASAN
   std::error_code error;
   std::uintmax_t size = std::filesystem::file_size(file, error);
   if (error) return;
-  if (extension == ".gltf") size = gltfBytes(file, size);
+  if (extension == ".gltf") size = gltfBytes(file, size, rule);
   long pages = 0;
   if (std::FILE* statm = std::fopen("/proc/self/statm", "r")) {
     if (std::fscanf(statm, "%ld", &pages) != 1) pages = 0;
@@ -165,11 +122,12 @@ int runMeshReader(int argc, char** argv) {
     ::nanosleep(&pause, nullptr);
   }
   const std::filesystem::path path = argv[7];
-  capAddressSpace(path, argv[5]);
+  const ReferencedFileRule rule(path, argv[6]);
+  capAddressSpace(path, argv[5], rule);
   MeshFile result;
   std::string error;
   try {
-    result = importMesh(path, argv[5], ReferencedFileRule(path, argv[6]));
+    result = importMesh(path, argv[5], rule);
   } catch (const MeshLoadError& e) {
     error = e.what();
   } catch (...) {

@@ -1,6 +1,7 @@
 #include "glint/mesh/mesh_size_estimate.h"
 
 #include <unistd.h>
+#include <cctype>
 
 #include <algorithm>
 #include <atomic>
@@ -94,8 +95,8 @@ std::string_view firstWord(std::string_view line) {
   return line.substr(begin, end - begin);
 }
 
-// Bytes of the glTF file plus the regular files its "uri" strings name (data: URIs are inside the
-// file already). A plain scan for `"uri"`, not a JSON parse: an estimate needs no more.
+}  // namespace
+
 std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size,
                         const ReferencedFileRule& rule) {
   std::uint64_t total = size;
@@ -118,8 +119,20 @@ std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size,
     if (open == std::string::npos) break;
     const std::size_t close = text.find('"', open + 1);
     if (close == std::string::npos) break;
-    const std::string uri = text.substr(open + 1, close - open - 1);
-    if (uri.rfind("data:", 0) == 0 || !seen.insert(uri).second) continue;
+    const std::string written = text.substr(open + 1, close - open - 1);
+    if (written.rfind("data:", 0) == 0 || !seen.insert(written).second) continue;
+    // URIs are percent-encoded (RFC 3986): "my%20mesh.bin" names "my mesh.bin".
+    std::string uri;
+    for (std::size_t k = 0; k < written.size(); ++k) {
+      if (written[k] == '%' && k + 2 < written.size() &&
+          std::isxdigit(static_cast<unsigned char>(written[k + 1])) &&
+          std::isxdigit(static_cast<unsigned char>(written[k + 2]))) {
+        uri.push_back(static_cast<char>(std::stoi(written.substr(k + 1, 2), nullptr, 16)));
+        k += 2;
+      } else {
+        uri.push_back(written[k]);
+      }
+    }
     // A file outside the mesh's folder tree is not read (the load refuses it): not counted.
     const std::filesystem::path named = path.parent_path() / uri;
     if (!rule.refusal(named).empty()) continue;
@@ -128,8 +141,6 @@ std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size,
   }
   return total;
 }
-
-}  // namespace
 
 MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path,
                                   const MeshReadOptions& options) {

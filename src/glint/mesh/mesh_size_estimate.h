@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "glint/core/file_access.h"
 #include "glint/mesh/mesh_file.h"
 
 namespace glint {
@@ -25,5 +26,12 @@ struct MeshSizeEstimate {
 // options.cancel is set (polled while the file is scanned).
 MeshSizeEstimate estimateMeshSize(const std::filesystem::path& path,
                                   const MeshReadOptions& options = {});
+
+// Bytes of a .gltf file (`size` of them) plus the regular files its "uri" strings name
+// (percent-decoded, beside it; data: URIs are inside the file already; files `rule` refuses are
+// not counted, the load refuses them). A plain scan for `"uri"`, not a JSON parse: an estimate
+// and the mesh reader's memory cap need no more.
+std::uint64_t gltfBytes(const std::filesystem::path& path, std::uint64_t size,
+                        const ReferencedFileRule& rule);
 
 }  // namespace glint
