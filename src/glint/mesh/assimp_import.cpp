@@ -535,38 +535,43 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
   return result;
 }
 
+// Calls read(bytes) with the mesh file's bytes, opened as assimp's importers open it
+// (MeshFileAccess) and mapped rather than copied: reading them into fresh memory costs a page
+// fault per 4 KiB, mapping them with MAP_POPULATE one call. (A file cut short while mapped kills
+// this child with SIGBUS: a refused file, as any crash here.) False when the file cannot be
+// opened or mapped, or is empty: the importer then says why in its words.
+template <class Read>
+bool readMapped(const std::filesystem::path& path, const ReferencedFileRule& rule, Read read) {
+  MeshFileAccess files(rule);
+  const ReadableFile file = files.openChecked(path.c_str());
+  struct stat status {};
+  if (file.fd < 0 || ::fstat(file.fd, &status) != 0 || status.st_size <= 0) return false;
+  const auto size = static_cast<std::size_t>(status.st_size);
+  void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd, 0);
+  if (mapped == MAP_FAILED) return false;
+  struct Unmap {
+    void* bytes;
+    std::size_t size;
+    ~Unmap() { ::munmap(bytes, size); }
+  } unmap{mapped, size};
+  read(std::string_view(static_cast<const char*>(mapped), size));
+  return true;
+}
+
 }  // namespace
 
 std::optional<MeshFile> importSimpleObj(const std::filesystem::path& path,
                                         const ReferencedFileRule& rule) {
   bool located = false;
   try {
-    // The bytes, opened as assimp's importers open the file (MeshFileAccess) and mapped rather
-    // than copied: reading them into fresh memory costs a page fault per 4 KiB, mapping them
-    // with MAP_POPULATE one call. (A file cut short while mapped kills this child with SIGBUS:
-    // a refused file, as any crash here.)
     std::optional<SimpleObj> obj;
     std::optional<ObjFault> fault;
-    {
-      MeshFileAccess files(rule);
-      const ReadableFile file = files.openChecked(path.c_str());
-      struct stat status {};
-      if (file.fd < 0 || ::fstat(file.fd, &status) != 0 || status.st_size <= 0) {
-        return std::nullopt;
-      }
-      const auto size = static_cast<std::size_t>(status.st_size);
-      void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd, 0);
-      if (mapped == MAP_FAILED) return std::nullopt;
-      try {
-        const std::string_view text(static_cast<const char*>(mapped), size);
-        obj = parseSimpleObj(text);
-        // A file outside the subset: its first malformed statement, if any, said at its place.
-        if (!obj) fault = findObjFault(text);
-      } catch (...) {
-        ::munmap(mapped, size);
-        throw;
-      }
-      ::munmap(mapped, size);
+    if (!readMapped(path, rule, [&](std::string_view text) {
+          obj = parseSimpleObj(text);
+          // A file outside the subset: its first malformed statement, if any, said at its place.
+          if (!obj) fault = findObjFault(text);
+        })) {
+      return std::nullopt;
     }
     if (fault) {
       // In the reason's words, as meshErrorPlace reads them.
@@ -623,22 +628,7 @@ namespace {
 void checkMeshText(const std::filesystem::path& path, const ReferencedFileRule& rule,
                    std::optional<MeshFileFault> (*find)(std::string_view)) {
   std::optional<MeshFileFault> fault;
-  {
-    MeshFileAccess files(rule);
-    const ReadableFile file = files.openChecked(path.c_str());
-    struct stat status {};
-    if (file.fd < 0 || ::fstat(file.fd, &status) != 0 || status.st_size <= 0) return;
-    const auto size = static_cast<std::size_t>(status.st_size);
-    void* mapped = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, file.fd, 0);
-    if (mapped == MAP_FAILED) return;  // assimp's words for it
-    try {
-      fault = find(std::string_view(static_cast<const char*>(mapped), size));
-    } catch (...) {
-      ::munmap(mapped, size);
-      throw;
-    }
-    ::munmap(mapped, size);
-  }
+  readMapped(path, rule, [&](std::string_view bytes) { fault = find(bytes); });
   if (!fault) return;
   // In the reason's words, as meshErrorPlace reads them.
   if (fault->line > 0) {
