@@ -8,6 +8,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <stdlib.h>
+#include <sys/ioctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <termios.h>
@@ -250,6 +251,65 @@ class Cli : public ::testing::Test {
     std::this_thread::sleep_for(300ms);
     kill(pid, signal);
     return finish(pid, 30s);
+  }
+
+  // Runs glint with stderr on a pseudo-terminal `columns` wide (0: the pty's default); returns its
+  // status and everything it wrote to the terminal.
+  RunResult runOnTerminal(const std::vector<std::string>& args, unsigned short columns = 0) {
+    RunResult result;
+    const int master = posix_openpt(O_RDWR | O_NOCTTY);
+    EXPECT_GE(master, 0);
+    if (master < 0) return result;
+    EXPECT_EQ(grantpt(master), 0);
+    EXPECT_EQ(unlockpt(master), 0);
+    const std::string slaveName = ptsname(master);
+    const int slave = open(slaveName.c_str(), O_RDWR | O_NOCTTY);
+    EXPECT_GE(slave, 0);
+    // Raw mode: the terminal must not turn "\n" into "\r\n", so every '\r' seen is glint's own.
+    termios mode{};
+    EXPECT_EQ(tcgetattr(slave, &mode), 0);
+    cfmakeraw(&mode);
+    EXPECT_EQ(tcsetattr(slave, TCSANOW, &mode), 0);
+    if (columns != 0) {
+      winsize size{};
+      size.ws_row = 24;
+      size.ws_col = columns;
+      EXPECT_EQ(ioctl(slave, TIOCSWINSZ, &size), 0);
+    }
+    const int outFd =
+        open((root_ / "capture" / "stdout").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const pid_t pid = fork();
+    if (pid == 0) {
+      close(master);
+      execGlint(args, work_, outFd, slave);
+    }
+    close(slave);
+    close(outFd);
+    // Drain the terminal while glint runs, so it never blocks on a full pty buffer.
+    const auto deadline = std::chrono::steady_clock::now() + 60s;
+    for (bool exited = false;;) {
+      pollfd fd{master, POLLIN, 0};
+      if (poll(&fd, 1, 20) > 0) {
+        char buffer[4096];
+        const ssize_t n = read(master, buffer, sizeof buffer);
+        if (n > 0) {
+          result.err.append(buffer, static_cast<std::size_t>(n));
+          continue;
+        }
+      }
+      if (exited) break;
+      int raw = 0;
+      if (waitpid(pid, &raw, WNOHANG) == pid) {
+        result.status = decodeStatus(raw);
+        exited = true;  // one more pass drains what is left
+      } else if (std::chrono::steady_clock::now() > deadline) {
+        kill(pid, SIGKILL);
+        waitpid(pid, nullptr, 0);
+        break;
+      }
+    }
+    close(master);
+    return result;
   }
 
   std::string small() const { return (kScenes / "small.yaml").string(); }

@@ -92,6 +92,23 @@ TEST_F(Cli, ArgumentParserErrorsExitTwo) {
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "--width is given more than once; give it once")) << r.err;
   EXPECT_FALSE(contains(r.err, "At Most")) << r.err;
+  // An option before the command is named, not taken for a missing command.
+  r = run({"--bogus"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "unknown option '--bogus': options go after the command")) << r.err;
+  // Arguments left over are listed in the order given.
+  r = run({"render", "--", small(), "--width", "16", "-o", "out.png"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "not expected: --width 16 -o out.png\n")) << r.err;
+  // A scene name with a leading '-' is read as an option: say so, and how to name the file.
+  r = run({"render", "-scene.yaml"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "unknown option '-scene.yaml'")) << r.err;
+  EXPECT_TRUE(contains(r.err, "./-scene.yaml")) << r.err;
+  // An empty output name is refused, not replaced by the default one.
+  r = run({"render", small(), "-o", ""});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "-o needs a file name")) << r.err;
   EXPECT_TRUE(filesIn(work_).empty());
 }
 
@@ -426,6 +443,11 @@ TEST_F(Cli, OutputPathsThatCannotBeAFileExitTwo) {
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "cannot write 'out.png': it is a folder")) << r.err;
   EXPECT_TRUE(fs::is_empty(work_ / "out.png"));
+  // A folder is a folder whatever its name: not "the name has no extension".
+  fs::create_directory(work_ / "renders");
+  r = run({"render", small(), "-o", "renders"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "cannot write 'renders': it is a folder")) << r.err;
   writeFile(work_ / "file", "precious");
   r = run({"render", small(), "-o", "file/out.png"});
   EXPECT_EQ(r.status, 2);
@@ -435,7 +457,7 @@ TEST_F(Cli, OutputPathsThatCannotBeAFileExitTwo) {
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "the file name is 304 bytes long, longer than the 255")) << r.err;
   EXPECT_FALSE(contains(r.err, "%")) << "it rendered first: " << r.err;
-  EXPECT_EQ(filesIn(work_), (std::set<std::string>{"file", "out.png"}));
+  EXPECT_EQ(filesIn(work_), (std::set<std::string>{"file", "out.png", "renders"}));
   EXPECT_EQ(readFile(work_ / "file"), "precious");
 }
 
@@ -727,59 +749,60 @@ TEST_F(Cli, AnIsaThatCannotRunExitsTwoAndWritesNothing) {
 }
 
 TEST_F(Cli, ProgressIsABarRedrawnInPlaceOnATerminal) {
-  const int master = posix_openpt(O_RDWR | O_NOCTTY);
-  ASSERT_GE(master, 0);
-  ASSERT_EQ(grantpt(master), 0);
-  ASSERT_EQ(unlockpt(master), 0);
-  const std::string slaveName = ptsname(master);
-  const int slave = open(slaveName.c_str(), O_RDWR | O_NOCTTY);
-  ASSERT_GE(slave, 0);
-  // Raw mode: the terminal must not turn "\n" into "\r\n", so every '\r' seen is glint's own.
-  termios mode{};
-  ASSERT_EQ(tcgetattr(slave, &mode), 0);
-  cfmakeraw(&mode);
-  ASSERT_EQ(tcsetattr(slave, TCSANOW, &mode), 0);
-  const int outFd =
-      open((root_ / "capture" / "stdout").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  const pid_t pid = fork();
-  if (pid == 0) {
-    close(master);
-    execGlint({"render", small(), "-o", "out.png"}, work_, outFd, slave);
-  }
-  close(slave);
-  close(outFd);
-  // Drain the terminal while glint runs, so it never blocks on a full pty buffer.
-  std::string err;
-  int status = -1;
-  const auto deadline = std::chrono::steady_clock::now() + 60s;
-  for (bool exited = false;;) {
-    pollfd fd{master, POLLIN, 0};
-    if (poll(&fd, 1, 20) > 0) {
-      char buffer[4096];
-      const ssize_t n = read(master, buffer, sizeof buffer);
-      if (n > 0) {
-        err.append(buffer, static_cast<std::size_t>(n));
-        continue;
-      }
-    }
-    if (exited) break;
-    int raw = 0;
-    if (waitpid(pid, &raw, WNOHANG) == pid) {
-      status = decodeStatus(raw);
-      exited = true;  // one more pass drains what is left
-    } else if (std::chrono::steady_clock::now() > deadline) {
-      kill(pid, SIGKILL);
-      waitpid(pid, nullptr, 0);
-      break;
-    }
-  }
-  close(master);
-  EXPECT_EQ(status, 0) << err;
+  const RunResult r = runOnTerminal({"render", small(), "-o", "out.png"});
+  const std::string& err = r.err;
+  EXPECT_EQ(r.status, 0) << err;
   EXPECT_TRUE(contains(err, "\rglint: [")) << err;
   EXPECT_TRUE(contains(err, "100%")) << err;
   EXPECT_FALSE(std::regex_search(err, std::regex("glint: [0-9]+% \\(elapsed"))) << "no log lines";
   EXPECT_TRUE(contains(err, "ETA")) << err;
   EXPECT_TRUE(contains(err, "Mrays/s")) << err;
+}
+
+// Progress and the summary are only messages: a full or closed stderr loses them, not the image.
+TEST_F(Cli, AStderrThatCannotBeWrittenDoesNotFailTheRender) {
+  // /dev/full: every write fails with ENOSPC; a read-only descriptor: with EBADF, as a closed one.
+  for (const bool full : {true, false}) {
+    const int outFd = open("/dev/null", O_WRONLY);
+    const int errFd = full ? open("/dev/full", O_WRONLY) : open("/dev/null", O_RDONLY);
+    ASSERT_GE(outFd, 0);
+    ASSERT_GE(errFd, 0);
+    const pid_t pid = fork();
+    if (pid == 0) execGlint({"render", small(), "-o", "out.png"}, work_, outFd, errFd);
+    close(outFd);
+    close(errFd);
+    EXPECT_EQ(waitFor(pid, 60s), 0) << (full ? "/dev/full" : "read-only");
+    EXPECT_TRUE(pngSize(work_ / "out.png").has_value()) << (full ? "/dev/full" : "read-only");
+    fs::remove(work_ / "out.png");
+  }
+}
+
+// A bar line as wide as the terminal would wrap, and then every redraw ('\r' goes back to the
+// start of the last row only) would add a row: each drawing of the bar stays narrower than the
+// terminal, the bar's cells going first.
+TEST_F(Cli, TheProgressBarFitsANarrowTerminal) {
+  for (const int columns : {80, 40, 12}) {
+    const RunResult r =
+        runOnTerminal({"render", small(), "-o", "out.png"}, static_cast<unsigned short>(columns));
+    EXPECT_EQ(r.status, 0) << r.err;
+    // The bar's drawings: from each '\r' to the next '\r' or '\n'.
+    std::size_t drawings = 0;
+    for (std::size_t at = r.err.find('\r'); at != std::string::npos; at = r.err.find('\r', at)) {
+      ++at;
+      const std::size_t end = r.err.find_first_of("\r\n", at);
+      const std::size_t length = (end == std::string::npos ? r.err.size() : end) - at;
+      EXPECT_LT(length, static_cast<std::size_t>(columns))
+          << columns << " columns: '" << r.err.substr(at, length) << "'";
+      ++drawings;
+    }
+    EXPECT_GE(drawings, 2u) << r.err;
+    if (columns == 80) {
+      EXPECT_TRUE(contains(r.err, "\rglint: [")) << "a bar at 80 columns: " << r.err;
+    }
+    if (columns == 40) {
+      EXPECT_TRUE(contains(r.err, "100%  elapsed")) << r.err;
+    }
+  }
 }
 
 // --- memory budget ------------------------------------------------------------------------

@@ -25,6 +25,7 @@
 #include <utility>
 #include <vector>
 
+#include "glint/cli/console.h"
 #include "glint/cli/preview_session.h"
 #include "glint/cli/progress_reporter.h"
 #include "glint/cli/signal_guard.h"
@@ -61,12 +62,6 @@ class CliError : public std::runtime_error {
  private:
   int exitCode_;
 };
-
-// Writes without throwing: a closed or full stderr must not turn a finished render into a failure.
-void emit(std::FILE* stream, std::string_view text) {
-  std::fwrite(text.data(), 1, text.size(), stream);
-  std::fflush(stream);
-}
 
 void printError(std::string_view message) {
   emit(stderr, fmt::format("glint: error: {}\n", message));
@@ -525,12 +520,46 @@ int runRender(const RenderArgs& args, SignalGuard& signals) {
   return renderAndReport(std::move(spec), args, signals, {});
 }
 
+// The arguments the parser could not place, in the order given ("--" left out).
+std::vector<std::string> unplacedArguments(const CLI::App& app) {
+  std::vector<std::string> words;
+  for (std::string& word : app.remaining(true)) {
+    if (word != "--") words.push_back(std::move(word));
+  }
+  return words;
+}
+
 // Argument-parser errors: CLI11's own message, minus its jargon, plus where to find help.
-int parseFailure(const CLI::ParseError& error) {
+int parseFailure(const CLI::ParseError& error, const CLI::App& app, int argc, char** argv) {
   const std::string_view message = error.what();
   const std::size_t colon = message.find(": ");
+  const std::vector<std::string> unplaced = unplacedArguments(app);
+  const auto firstOption = std::find_if(unplaced.begin(), unplaced.end(), [](const auto& word) {
+    return word.size() > 1 && word[0] == '-';
+  });
   if (message == "A subcommand is required") {
-    printError("a command is required: glint render SCENE, or glint check SCENE");
+    if (argc >= 2 && argv[1][0] == '-') {
+      printError(
+          fmt::format("unknown option '{}': options go after the command, as in glint "
+                      "render SCENE --width 800",
+                      argv[1]));
+    } else {
+      printError(
+          "a command is required: glint render SCENE, glint check SCENE or glint convert "
+          "SCENE");
+    }
+  } else if (dynamic_cast<const CLI::RequiredError*>(&error) && firstOption != unplaced.end()) {
+    // "glint render -scene.yaml": the name was taken for an option, so SCENE is "missing".
+    printError(
+        fmt::format("unknown option '{}' (a file whose name starts with '-' is written "
+                    "./{})",
+                    *firstOption, *firstOption));
+  } else if (dynamic_cast<const CLI::ExtrasError*>(&error) && unplaced.size() == 1 &&
+             firstOption != unplaced.end()) {
+    printError(fmt::format("unknown option '{}'", unplaced.front()));
+  } else if (dynamic_cast<const CLI::ExtrasError*>(&error) && !unplaced.empty()) {
+    // CLI11 lists them in reverse order.
+    printError(fmt::format("not expected: {}", fmt::join(unplaced, " ")));
   } else if (dynamic_cast<const CLI::ArgumentMismatch*>(&error) &&
              colon != std::string_view::npos && message.ends_with(" missing")) {
     // CLI11 says "--width: 1 required W missing".
@@ -560,11 +589,12 @@ int runCommandLine(int argc, char** argv) {
   render->add_option("SCENE", args.scene, "Scene file (YAML, JSON, .nff, .dat, or a mesh file)")
       ->required()
       ->type_name("FILE");
-  render
-      ->add_option("-o,--output", args.output,
-                   "Output image: .png (8-bit), .ppm (8-bit) or .exr (linear float); "
-                   "default: the scene's name with .png, in the current folder")
-      ->type_name("OUT");
+  CLI::Option* outputOption =
+      render
+          ->add_option("-o,--output", args.output,
+                       "Output image: .png (8-bit), .ppm (8-bit) or .exr (linear float); "
+                       "default: the scene's name with .png, in the current folder")
+          ->type_name("OUT");
   // Valued options are read as text and parsed by parseRequest (uniform messages, no wrap-around).
   std::string width, height, samples, threads, seed, crop, integrator;
   CLI::Option* widthOption =
@@ -635,11 +665,13 @@ int runCommandLine(int argc, char** argv) {
   convert->add_option("SCENE", convertFile, "Scene file (YAML, .nff, .dat, or a mesh file)")
       ->required()
       ->type_name("FILE");
-  convert
-      ->add_option("-o,--output", convertOutput,
-                   "The YAML scene to write (large meshes go beside it as PLY files); default: the "
-                   "scene's name with .yaml, in the current folder")
-      ->type_name("OUT");
+  CLI::Option* convertOutputOption =
+      convert
+          ->add_option(
+              "-o,--output", convertOutput,
+              "The YAML scene to write (large meshes go beside it as PLY files); default: the "
+              "scene's name with .yaml, in the current folder")
+          ->type_name("OUT");
 
   // Set after the subcommands exist: CLI11 copies a parent's footer into subcommands made later.
   const std::string exitStatus =
@@ -671,8 +703,12 @@ int runCommandLine(int argc, char** argv) {
   } catch (const CLI::Success& success) {
     return app.exit(success);  // --help, --version: printed on stdout, exit 0
   } catch (const CLI::ParseError& error) {
-    return parseFailure(error);
+    return parseFailure(error, app, argc, argv);
   }
+  // An empty name ("-o $OUT" with OUT unset) is a mistake, not a request for the default name.
+  if ((outputOption->count() > 0 && args.output.empty()) ||
+      (convertOutputOption->count() > 0 && convertOutput.empty()))
+    throw CliError(kExitBadInput, "-o needs a file name");
   const auto given = [](const CLI::Option* option, const std::string& text) {
     return option->count() > 0 ? std::optional<std::string>(text) : std::nullopt;
   };

@@ -10,15 +10,11 @@
 #include <thread>
 #include <utility>
 
+#include "glint/cli/console.h"
 #include "glint/preview/job_preview.h"
 
 namespace glint::cli {
 namespace {
-
-void emit(std::FILE* stream, std::string_view text) {
-  std::fwrite(text.data(), 1, text.size(), stream);
-  std::fflush(stream);
-}
 
 // A linger time is a convenience, not a service: more than a day is a typo.
 constexpr double kMaxLingerSeconds = 86400;

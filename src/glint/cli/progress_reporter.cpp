@@ -1,10 +1,14 @@
 #include "glint/cli/progress_reporter.h"
 
 #include <fmt/format.h>
+#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
+
+#include "glint/cli/console.h"
 
 namespace glint::cli {
 namespace {
@@ -78,28 +82,54 @@ void ProgressReporter::update(std::size_t done, std::size_t total) {
 
 void ProgressReporter::finish() {
   if (style_ == Style::Bar && barDrawn_) {
-    std::fputc('\n', stream_);
-    std::fflush(stream_);
+    emit(stream_, "\n");
     barDrawn_ = false;
+    barLength_ = 0;
   }
 }
 
 void ProgressReporter::drawBar(std::size_t done, std::size_t total, double elapsed) {
   const int percent = percentOf(done, total);
-  const int filled = percent * kBarCells / 100;
-  std::string bar(static_cast<std::size_t>(filled), '#');
-  bar.append(static_cast<std::size_t>(kBarCells - filled), '.');
-  // Trailing blanks overwrite the end of a longer previous line (an ETA in minutes, say).
-  fmt::print(stream_, "\rglint: [{}] {:3}%  elapsed {}  ETA {}      ", bar, percent,
-             formatDuration(elapsed), formatEta(etaSeconds(done, total, resumed_, elapsed)));
-  std::fflush(stream_);
+  const std::string times =
+      fmt::format("{:3}%  elapsed {}  ETA {}", percent, formatDuration(elapsed),
+                  formatEta(etaSeconds(done, total, resumed_, elapsed)));
+  // The line must stay shorter than the terminal: a line that wraps makes every redraw ('\r'
+  // returns only to the start of the last row) a new row. The bar gives up cells first, then the
+  // line is cut.
+  const std::size_t columns = terminalColumns();
+  const std::size_t frame = std::string_view("glint: [] ").size() + times.size();
+  int cells = kBarCells;
+  if (columns != 0 && frame + kBarCells >= columns) {
+    cells = frame + 1 < columns ? static_cast<int>(columns - 1 - frame) : 0;
+  }
+  const int filled = percent * cells / 100;
+  std::string line = "glint: ";
+  if (cells > 0) {
+    line += '[';
+    line.append(static_cast<std::size_t>(filled), '#');
+    line.append(static_cast<std::size_t>(cells - filled), '.');
+    line += "] ";
+  }
+  line += times;
+  if (columns != 0 && line.size() >= columns) line.resize(columns - 1);
+  // Blanks overwrite the end of a longer previous line (an ETA in minutes, say).
+  const std::size_t length = line.size();
+  if (length < barLength_) line.append(barLength_ - length, ' ');
+  barLength_ = length;
+  emit(stream_, "\r" + line);
   barDrawn_ = true;
 }
 
+std::size_t ProgressReporter::terminalColumns() const {
+  winsize size{};
+  if (ioctl(fileno(stream_), TIOCGWINSZ, &size) != 0) return 0;
+  return size.ws_col;
+}
+
 void ProgressReporter::printLine(std::size_t done, std::size_t total, double elapsed) {
-  fmt::print(stream_, "glint: {}% (elapsed {}, ETA {})\n", percentOf(done, total),
-             formatDuration(elapsed), formatEta(etaSeconds(done, total, resumed_, elapsed)));
-  std::fflush(stream_);
+  emit(stream_,
+       fmt::format("glint: {}% (elapsed {}, ETA {})\n", percentOf(done, total),
+                   formatDuration(elapsed), formatEta(etaSeconds(done, total, resumed_, elapsed))));
 }
 
 }  // namespace glint::cli

@@ -38,13 +38,16 @@ class ProgressReporter {
   double elapsedSeconds() const;
   void drawBar(std::size_t done, std::size_t total, double elapsed);
   void printLine(std::size_t done, std::size_t total, double elapsed);
+  // The width of the terminal the stream writes to, or 0 when it is not known.
+  std::size_t terminalColumns() const;
 
   Style style_;
   std::FILE* stream_;
   Clock::time_point start_;
   Clock::time_point lastDraw_;
-  int lastDecile_ = 0;     // Lines: the last 10% step printed
-  bool barDrawn_ = false;  // Bar: something is on the current line
+  int lastDecile_ = 0;         // Lines: the last 10% step printed
+  bool barDrawn_ = false;      // Bar: something is on the current line
+  std::size_t barLength_ = 0;  // Bar: characters of the line drawn last, blanks left out
   bool lastPrinted100_ = false;
   std::size_t resumed_ = 0;
 };

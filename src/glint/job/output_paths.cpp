@@ -37,6 +37,11 @@ fs::path defaultOutputPath(const fs::path& scene) { return scene.stem().concat("
 
 void checkOutputPath(const fs::path& out, const fs::path& scene,
                      const std::optional<fs::path>& resume) {
+  std::error_code error;
+  // Before the extension: "images.png/" or "renders" is a folder, whatever its name says.
+  if (fs::is_directory(out, error))
+    throw JobError(JobFailure::BadInput,
+                   fmt::format("cannot write '{}': it is a folder", out.string()));
   const std::unique_ptr<ImageWriter> writer = writerForPath(out);
   if (!writer) {
     const std::string extension = out.extension().string();
@@ -46,7 +51,6 @@ void checkOutputPath(const fs::path& out, const fs::path& scene,
                                                  : "unknown image format '" + extension + "'"));
   }
   const fs::path folder = folderOf(out);
-  std::error_code error;
   if (!fs::is_directory(folder, error)) {
     const bool exists = fs::exists(folder, error);
     throw JobError(
@@ -62,9 +66,6 @@ void checkOutputPath(const fs::path& out, const fs::path& scene,
                    fmt::format("cannot write '{}': the file name is {} bytes long, longer than "
                                "the {} its folder allows",
                                out.string(), out.filename().string().size(), nameMax));
-  if (fs::is_directory(out, error))
-    throw JobError(JobFailure::BadInput,
-                   fmt::format("cannot write '{}': it is a folder", out.string()));
   // The image replaces its target only when complete, but it would still replace an input.
   if (!scene.empty() && sameFile(out, scene))
     throw JobError(JobFailure::BadInput,
