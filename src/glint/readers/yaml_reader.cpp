@@ -215,8 +215,51 @@ std::string plainProblem(std::string_view problem, std::string_view at) {
   }
   if (problem == "did not find expected node content" ||
       problem == "did not find expected <document start>" ||
-      problem == "found character that cannot start any token") {
+      problem == "found character that cannot start any token" ||
+      problem == "found unexpected ':'") {
     return "unexpected " + quoted + " here";
+  }
+  if (problem == "mapping keys are not allowed in this context") {
+    return "unexpected '?' here (explicit '? key' entries are not used in scene files)";
+  }
+  if (problem == "found unexpected document indicator") {
+    return "a line inside quoted text starts with '---' or '...' (missing closing quote?)";
+  }
+  if (problem == "found invalid Unicode character escape code") {
+    return "an escape sequence in quoted text names no Unicode character";
+  }
+  // Anchors (&name) and aliases (*name).
+  if (problem == "did not find expected alphabetic or numeric character") {
+    return "an anchor ('&') or alias ('*') needs a name of letters, digits, '-' or '_'";
+  }
+  // Block scalars (| and >).
+  if (problem == "found an indentation indicator equal to 0") {
+    return "the indentation digit after '|' or '>' must be 1 to 9";
+  }
+  if (problem == "did not find expected comment or line break") {
+    return "unexpected " + quoted + " here (only a comment may follow on this line)";
+  }
+  // Tags (!name, !<uri>, !handle!suffix).
+  if (problem == "found undefined tag handle" || problem == "did not find the expected '>'" ||
+      problem == "did not find expected '>'" || problem == "did not find expected tag URI" ||
+      problem == "did not find expected '!'" || problem == "did not find URI escaped octet" ||
+      problem == "found an incorrect leading UTF-8 octet" ||
+      problem == "found an incorrect trailing UTF-8 octet" ||
+      problem == "did not find expected whitespace or line break" ||
+      problem == "found duplicate %TAG directive") {
+    return "a malformed YAML tag ('!' and what follows it); scene files need no tags";
+  }
+  // Directives (%YAML, %TAG).
+  if (problem == "found incompatible YAML document") {
+    return "the %YAML line asks for a YAML version other than 1.x";
+  }
+  if (problem == "found duplicate %YAML directive") return "the %YAML line is given twice";
+  if (problem.find("directive") != std::string_view::npos ||
+      problem == "found unexpected non-alphabetical character" ||
+      problem == "did not find expected digit or '.' character" ||
+      problem == "found extremely long version number" ||
+      problem == "did not find expected whitespace") {
+    return "a malformed '%' line (a YAML directive such as %YAML 1.2)";
   }
   return std::string(problem);
 }

@@ -235,6 +235,30 @@ TEST(SceneParser, SyntaxErrorAtItsMark) {
                  "\\uHHHH or \\UHHHHHHHH)");
 }
 
+// Every syntax problem libyaml reports is worded for the scene's author: tags, anchors, block
+// scalars, directives and explicit keys included (libyaml says "found undefined tag handle", "did
+// not find expected alphabetic or numeric character", ...).
+TEST(SceneParser, RarerSyntaxErrorsInPlainWords) {
+  const std::string kLine2 = "camera: {position: [0, 0, 5], look_at: [0, 0, 0], fov: 40}\n";
+  const std::string head = "image: {width: 8, height: 8}\n" + kLine2;
+  expectOneError(head + "name: [a, 1:, b]\n", 3, 12, "syntax error: unexpected ':' here");
+  for (const char* tag : {"name: !foo!bar x\n", "name: !<foo x\n"}) {
+    const std::vector<Diagnostic> errors = errorsOf(head + tag);
+    ASSERT_EQ(errors.size(), 1u) << tag;
+    EXPECT_THAT(errors[0].message, HasSubstr("a malformed YAML tag")) << tag;
+  }
+  expectOneError(head + "name: & x\n", 3, 8,
+                 "an anchor ('&') or alias ('*') needs a name of letters, digits, '-' or '_'");
+  expectOneError(head + "name: |0\n", 3, 8,
+                 "the indentation digit after '|' or '>' must be 1 to 9");
+  expectOneError(head + "name: ? complex\n", 3, 7, "unexpected '?' here");
+  expectOneError("%YAML 2.0\n---\n" + head, 1, 1,
+                 "the %YAML line asks for a YAML version other than 1.x");
+  expectOneError("%YAML 1.1\n%YAML 1.1\n---\n" + head, 2, 1, "the %YAML line is given twice");
+  expectOneError(head + "name: \"abc\n---\nx\"\n", 4, 1,
+                 "a line inside quoted text starts with '---' or '...'");
+}
+
 TEST(SceneParser, EmptyOrNonMappingFileAtLineOne) {
   expectOneError("", 1, 1, "the file is empty");
   expectOneError("# only a comment\n\n", 1, 1, "the file is empty");
