@@ -32,7 +32,7 @@ class Codec {
   // Writes `path` (which exists: opened again by name) as width × height pixels of 32-bit float R,
   // G and B planes (`red`, `green`, `blue`, rows from the top), `rowsPerCall` rows at a time,
   // calling `rowsWritten(rows so far)` after each; once it returns false the file is left as it is.
-  // Returns "" or OpenEXR's message.
+  // Returns "" or why not, worded for the user ("write error: File too large").
   virtual std::string write(const char* path, int width, int height, const float* red,
                             const float* green, const float* blue, int rowsPerCall,
                             const std::function<bool(int rows)>& rowsWritten) = 0;

@@ -309,7 +309,7 @@ class ExrWriter final : public ImageWriter {
     };
     error = codec->write(temp.path().c_str(), width, height, red.data(), green.data(), blue.data(),
                          kExrRowsPerCall, rowsWritten);
-    if (!error.empty()) fail(path, "OpenEXR error: " + error);
+    if (!error.empty()) fail(path, error);
     if (cancelled) throw Cancelled();
     if (callbackError) std::rethrow_exception(callbackError);
     temp.commit();

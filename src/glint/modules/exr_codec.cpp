@@ -1,5 +1,6 @@
 // glint-exr.so: image/exr_module.h on OpenEXR — textures decoded from memory through its RGBA
 // interface, images written as 32-bit float R, G, B. The only file of glint that includes OpenEXR.
+#include <IexErrnoExc.h>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -8,6 +9,7 @@
 #include <ImfRgbaFile.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -116,9 +118,26 @@ class OpenExrCodec final : public Codec {
       return {};
     } catch (const std::bad_alloc&) {
       throw;
+    } catch (const Iex::ErrnoExc& e) {
+      // OpenEXR's message names the temporary file; the system's reason is what the user needs.
+      return "write error: " + systemReason(e);
     } catch (const std::exception& e) {
-      return e.what();
+      return std::string("OpenEXR error: ") + e.what();
     }
+  }
+
+ private:
+  // The errno behind a failed write, from the exception class OpenEXR chose for it
+  // (Iex::throwErrnoExc); OpenEXR's own words for any other.
+  static std::string systemReason(const Iex::ErrnoExc& e) {
+    int code = 0;
+    if (dynamic_cast<const Iex::EfbigExc*>(&e) != nullptr) code = EFBIG;
+    if (dynamic_cast<const Iex::EnospcExc*>(&e) != nullptr) code = ENOSPC;
+    if (dynamic_cast<const Iex::EdquotExc*>(&e) != nullptr) code = EDQUOT;
+    if (dynamic_cast<const Iex::EioExc*>(&e) != nullptr) code = EIO;
+    if (dynamic_cast<const Iex::EaccesExc*>(&e) != nullptr) code = EACCES;
+    if (dynamic_cast<const Iex::ErofsExc*>(&e) != nullptr) code = EROFS;
+    return code != 0 ? std::strerror(code) : e.what();
   }
 };
 
