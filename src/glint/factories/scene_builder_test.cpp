@@ -358,6 +358,9 @@ TEST(SceneBuilder, ValuesOutOfRangeAtTheValue) {
        "background.up must be non-zero"},
       {"background: {type: sky, top: [0, 0, 1], bottom: [1, 1, 1], bottom_value: .nan}\n", 3, 74,
        "background.bottom_value must be a finite number, got .nan"},
+      // The one error of a background mapping without a type (not also "unknown key 'zenith'
+      // ... expected one of:" with nothing after it).
+      {"background: {zenith: [0, 0, 1]}\n", 3, 13, "background is missing required key 'type'"},
       {"materials: {m: {kd: \"#12345\"}}\n", 3, 21,
        "materials.m.kd: expected a color \"#rrggbb\" with 6 hexadecimal digits"},
   };

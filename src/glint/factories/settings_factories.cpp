@@ -302,13 +302,16 @@ void buildEnvironment(const ValueReader& reader, const Entity& e, BuildContext& 
     if (file && p.errors() == 0 && ctx.textures != nullptr) {
       environment.image = ctx.textures->image(p, file->where, file->value, encoding);
     }
-  } else if (type) {
-    p.error(type->where,
-            fmt::format("unknown background type {}; expected gradient, sky or image (or give a "
-                        "colour instead of a mapping){}",
-                        quoteForMessage(type->value),
-                        didYouMean(type->value,
-                                   std::vector<std::string_view>{"gradient", "sky", "image"})));
+  } else {
+    if (type) {
+      p.error(type->where,
+              fmt::format("unknown background type {}; expected gradient, sky or image (or give a "
+                          "colour instead of a mapping){}",
+                          quoteForMessage(type->value),
+                          didYouMean(type->value,
+                                     std::vector<std::string_view>{"gradient", "sky", "image"})));
+    }
+    // Without a known type no key can be judged: the type's error is the only one.
     p.markUsed(p.keys());
   }
   p.finish();
