@@ -8,10 +8,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 #include <set>
 #include <string>
@@ -23,6 +25,7 @@
 #include "glint/readers/nff_reader.h"
 #include "glint/readers/tachyon_reader.h"
 #include "glint/render/renderer.h"
+#include "glint/writers/ply_writer.h"
 #include "glint/writers/yaml_scene_writer.h"
 
 namespace glint {
@@ -254,7 +257,7 @@ class Convert : public ::testing::Test {
   void expectSameImage(const fs::path& file, std::size_t plyFiles, int width = 0) {
     const fs::path output = folder_ / "out" / (file.stem().string() + ".yaml");
     fs::create_directories(output.parent_path());
-    const ConvertResult result = convertScene(ConvertSpec{file, output, nullptr});
+    const ConvertResult result = convertScene(ConvertSpec{file, output, nullptr, {}});
     EXPECT_EQ(result.meshFiles.size(), plyFiles);
     LoadOptions options;
     if (width > 0) options.overrides.width = width;
@@ -270,8 +273,20 @@ class Convert : public ::testing::Test {
     EXPECT_EQ(different, 0) << file;
   }
 
+  // scenes/textures/uv_grid.png as maps/chart.png in the folder.
+  void copyChart() {
+    fs::create_directories(folder_ / "maps");
+    fs::copy_file(fs::path(GLINT_SOURCE_DIR) / "scenes" / "textures" / "uv_grid.png",
+                  folder_ / "maps" / "chart.png");
+  }
+
   fs::path folder_;
 };
+
+std::string readText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 TEST_F(Convert, NffRendersTheSameBytes) { expectSameImage(write("sphere.nff", kNffSphere), 0); }
 
@@ -303,14 +318,14 @@ TEST_F(Convert, LargePolygonSetsGoToPlyFilesAndRenderTheSameBytes) {
   }
   expectSameImage(write("grid.nff", nff), 2);
   // Every file or none: a folder where the second mesh file would go fails the convert before
-  // anything is written (the first mesh file was left behind).
+  // anything is written.
   const fs::path output = folder_ / "blocked" / "grid.yaml";
   fs::create_directories(folder_ / "blocked" / "grid_mesh2.ply");
   try {
-    convertScene(ConvertSpec{folder_ / "grid.nff", output, nullptr});
+    convertScene(ConvertSpec{folder_ / "grid.nff", output, nullptr, {}});
     ADD_FAILURE() << "not refused";
   } catch (const JobError& e) {
-    EXPECT_EQ(e.exitCode(), 1);
+    EXPECT_EQ(e.exitCode(), 2);  // as an output image that is a folder
     EXPECT_THAT(e.what(), testing::HasSubstr("grid_mesh2.ply: cannot write: it is a folder"));
   }
   std::set<std::string> left;
@@ -343,6 +358,108 @@ TEST_F(Convert, TexturesAndTheirImageFilesKeepTheirPaths) {
             "  - {type: rectangle, corner: [-2, -1.5, -1], edges: [[4, 0, 0], [0, 3, 0]], "
             "material: {ka: {type: image, file: library/maps/chart.png}}}\n"),
       0);
+}
+
+// A YAML inline mesh of 8,192 triangles (a PLY file when converted) without normals, a solid
+// checker in kd and an image file (maps/chart.png beside the scene) in ka.
+std::string texturedGridScene(const std::string& extraObject) {
+  std::string positions, indices;
+  constexpr int kCells = 64;
+  for (int j = 0; j <= kCells; ++j) {
+    for (int i = 0; i <= kCells; ++i) {
+      const double x = i * 4.0 / kCells - 2, y = j * 3.0 / kCells - 1.5;
+      positions += fmt::format("{}[{}, {}, {}]", positions.empty() ? "" : ", ", x, y,
+                               0.3 * std::sin(3 * x) * std::cos(2 * y));
+    }
+  }
+  for (int j = 0; j < kCells; ++j) {
+    for (int i = 0; i < kCells; ++i) {
+      const int a = j * (kCells + 1) + i, b = a + 1, c = a + kCells + 1, d = c + 1;
+      indices += fmt::format("{}[{}, {}, {}], [{}, {}, {}]", indices.empty() ? "" : ", ", a, b, d,
+                             a, d, c);
+    }
+  }
+  return "camera: {position: [0, -3, 4], look_at: [0, 0, 0], fov: 45}\n"
+         "image: {width: 48, height: 36}\n"
+         "lights: [{type: point, position: [3, -2, 5]}]\n"
+         "objects:\n"
+         "  - {type: mesh, positions: [" +
+         positions + "], indices: [" + indices +
+         "], material: {kd: {type: checker, colors: [[0.9, 0.2, 0.1], [0.9, 0.9, 0.8]], scale: "
+         "0.5}, ks: 0.5, shininess: 30, ka: {type: image, file: maps/chart.png}}}\n" +
+         extraObject;
+}
+
+// Rendering the conversion gives the same bytes also when the inline mesh becomes a PLY file:
+// without normals it stays flat (a mesh file without normals would get generated ones), and a
+// texture file its material names is found from the output's folder.
+TEST_F(Convert, InlineMeshesWrittenAsPlyKeepFlatFacetsAndTheirTextures) {
+  copyChart();
+  expectSameImage(write("grid.yaml", texturedGridScene("")), 1);
+  EXPECT_THAT(readText(folder_ / "out" / "grid.yaml"), testing::HasSubstr("smooth: false"));
+}
+
+// The files a conversion writes never replace a file the scene reads: a PLY file of the scene's
+// own takes another name, and an output named as an included file is refused (exit status 2).
+TEST_F(Convert, NothingTheSceneReadsIsWrittenOver) {
+  copyChart();
+  fs::create_directories(folder_ / "out");
+  // A mesh file of the name the first PLY file would take.
+  PlyMesh triangle;
+  triangle.positions = {-2, 1, -1, -1, 1, -1, -1.5, 1.5, -1};
+  triangle.indices = {0, 1, 2};
+  const std::string ownBytes = binaryPly(triangle);
+  std::ofstream(folder_ / "out" / "grid_mesh1.ply", std::ios::binary) << ownBytes;
+  expectSameImage(
+      write("grid.yaml", texturedGridScene("  - {type: mesh, file: out/grid_mesh1.ply}\n")), 1);
+  EXPECT_EQ(readText(folder_ / "out" / "grid_mesh1.ply"), ownBytes);
+  EXPECT_TRUE(fs::exists(folder_ / "out" / "grid_mesh2.ply"));
+
+  write("library.yaml", "materials:\n  red: {kd: [1, 0, 0]}\n");
+  const fs::path scene = write(
+      "main.yaml",
+      "include: library.yaml\ncamera: {position: [0, 0, 4], look_at: [0, 0, 0], fov: 40}\n"
+      "image: {width: 8, height: 6}\nobjects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, "
+      "material: red}\n");
+  try {
+    convertScene(ConvertSpec{scene, folder_ / "library.yaml", nullptr, {}});
+    ADD_FAILURE() << "not refused";
+  } catch (const JobError& e) {
+    EXPECT_EQ(e.exitCode(), 2);
+    EXPECT_THAT(e.what(), testing::HasSubstr("the scene being converted reads this file"));
+  }
+  EXPECT_EQ(readText(folder_ / "library.yaml"), "materials:\n  red: {kd: [1, 0, 0]}\n");
+}
+
+// A cancel seen before the files are renamed writes nothing and leaves no temporary file; the
+// renames happen with `committing` true.
+TEST_F(Convert, ACancelWritesNothingAndTheRenamesAreOneCommit) {
+  copyChart();
+  const fs::path scene = write("grid.yaml", texturedGridScene(""));
+  fs::create_directories(folder_ / "out");
+  std::atomic<bool> cancel{true};
+  ConvertSpec spec{scene, folder_ / "out" / "grid.yaml", &cancel, {}};
+  std::vector<bool> commits;
+  spec.committing = [&commits](bool committing) { commits.push_back(committing); };
+  EXPECT_TRUE(convertScene(spec).interrupted);
+  EXPECT_TRUE(fs::is_empty(folder_ / "out"));
+  EXPECT_TRUE(commits.empty());
+  cancel = false;
+  const ConvertResult result = convertScene(spec);
+  EXPECT_FALSE(result.interrupted);
+  EXPECT_EQ(result.meshFiles.size(), 1u);
+  EXPECT_EQ(commits, (std::vector<bool>{true, false}));
+}
+
+TEST(YamlScalar, ControlCharactersAreEscaped) {
+  EXPECT_EQ(yamlScalar("a\x7f"
+                       "b"),
+            "\"a\\x7fb\"");
+  EXPECT_EQ(yamlScalar("a\xc2\x80"
+                       "b"),
+            "\"a\\u0080b\"");
+  EXPECT_EQ(yamlScalar("caf\xc3\xa9"), "\"caf\xc3\xa9\"");  // é is no control character
+  EXPECT_EQ(yamlScalar("tab\there"), "\"tab\\there\"");
 }
 
 TEST_F(Convert, YamlWithAMeshFileKeepsItsPath) {

@@ -343,12 +343,19 @@ int runCheck(const std::string& file) {
   return kExitSuccess;
 }
 
-int runConvert(const std::string& file, const std::string& output) {
+int runConvert(const std::string& file, const std::string& output, SignalGuard& signals) {
   ConvertResult result;
   try {
-    result = convertScene(ConvertSpec{file, output, nullptr});
+    ConvertSpec spec{file, output, &signals.cancelFlag(), {}};
+    spec.committing = [&signals](bool committing) { signals.setCommitting(committing); };
+    result = convertScene(spec);
   } catch (const JobError& error) {
     return reportJobError(error, file);
+  }
+  if (result.interrupted) {
+    emit(stderr, "glint: interrupted; nothing was written\n");
+    return SignalGuard::exitCodeFor(signals.receivedSignal() != 0 ? signals.receivedSignal()
+                                                                  : SIGINT);
   }
   printDiagnostics(result.warnings);
   std::string files;
@@ -730,8 +737,8 @@ int runCommandLine(int argc, char** argv) {
   }
 
   if (check->parsed()) return runCheck(checkFile);
-  if (convert->parsed()) return runConvert(convertFile, convertOutput);
   SignalGuard signals;
+  if (convert->parsed()) return runConvert(convertFile, convertOutput, signals);
   return runRender(args, signals);
 }
 

@@ -1,5 +1,8 @@
 #include "glint/job/scene_convert.h"
 
+#include <unistd.h>
+
+#include <cctype>
 #include <cerrno>
 #include <memory>
 #include <string>
@@ -10,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "glint/core/atomic_file.h"
+#include "glint/core/cancel.h"
 #include "glint/factories/scene_loader.h"
 #include "glint/job/job_error.h"
 #include "glint/writers/yaml_scene_writer.h"
@@ -24,21 +28,44 @@ fs::path outputFor(const ConvertSpec& spec) {
   return fs::path(spec.scene.stem().string() + ".yaml");
 }
 
+std::string lowercase(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
+// A file the conversion writes (the scene or a PLY file) that cannot be one: exit status 2,
+// before the scene is even read.
+void checkTarget(const fs::path& target) {
+  std::error_code error;
+  if (fs::is_directory(target, error)) {
+    throw JobError(JobFailure::BadInput,
+                   fmt::format("{}: cannot write: it is a folder", target.string()));
+  }
+  fs::path folder = target.parent_path();
+  if (folder.empty()) folder = ".";
+  if (!fs::is_directory(folder, error)) {
+    throw JobError(JobFailure::BadInput, fmt::format("{}: the folder {} does not exist",
+                                                     target.string(), folder.string()));
+  }
+  const long nameMax = ::pathconf(folder.c_str(), _PC_NAME_MAX);
+  if (nameMax > 0 && target.filename().string().size() > static_cast<std::size_t>(nameMax)) {
+    throw JobError(JobFailure::BadInput,
+                   fmt::format("{}: cannot write: the file name is {} bytes long, longer than the "
+                               "{} its folder allows",
+                               target.string(), target.filename().string().size(), nameMax));
+  }
+}
+
 void checkOutput(const fs::path& output, const fs::path& scene) {
-  const std::string extension = output.extension().string();
+  const std::string extension = lowercase(output.extension().string());
   // The scene is written in YAML's flow style, which is not JSON: a .json name would mislead.
   if (extension != ".yaml" && extension != ".yml") {
     throw JobError(JobFailure::BadInput,
                    fmt::format("{}: the converted scene is YAML (not JSON); name it .yaml or .yml",
                                output.string()));
   }
-  fs::path folder = output.parent_path();
-  if (folder.empty()) folder = ".";
+  checkTarget(output);
   std::error_code error;
-  if (!fs::is_directory(folder, error)) {
-    throw JobError(JobFailure::BadInput, fmt::format("{}: the folder {} does not exist",
-                                                     output.string(), folder.string()));
-  }
   if (fs::exists(output, error) && fs::equivalent(output, scene, error)) {
     throw JobError(JobFailure::BadInput,
                    fmt::format("{}: the output is the scene being converted; choose another name",
@@ -46,26 +73,40 @@ void checkOutput(const fs::path& output, const fs::path& scene) {
   }
 }
 
-// Writes every file (the meshes, then the scene) or none: each is written whole to a temporary
-// file first, and only when all are complete are they renamed over their targets. A target that
-// is a folder is refused before anything is written (the rename would fail after the others).
-void writeAllOrNothing(const std::vector<std::pair<fs::path, const std::string*>>& files) {
-  std::vector<std::unique_ptr<AtomicFile>> written;
-  for (const auto& [target, bytes] : files) {
-    std::error_code error;
-    if (fs::is_directory(target, error)) {
-      throw JobError(JobFailure::Failure,
-                     fmt::format("{}: cannot write: it is a folder", target.string()));
-    }
+// Whether `target` is one of the files the scene reads (by name, or the same file by another).
+bool readByScene(const fs::path& target, const std::vector<fs::path>& inputs) {
+  const fs::path absolute = fs::absolute(target).lexically_normal();
+  std::error_code error;
+  for (const fs::path& input : inputs) {
+    if (input == absolute || fs::equivalent(input, target, error)) return true;
   }
+  return false;
+}
+
+// Writes every file (the meshes, then the scene) or none: each is written whole to a temporary
+// file first, and only when all are complete are they renamed over their targets, with
+// `committing` true meanwhile (the CLI then lets no signal end the process: a set half renamed
+// would mix old and new files). A cancel seen before the renames writes nothing.
+void writeAllOrNothing(const std::vector<std::pair<fs::path, const std::string*>>& files,
+                       const ConvertSpec& spec) {
+  std::vector<std::unique_ptr<AtomicFile>> written;
   const fs::path* current = nullptr;
   try {
     for (const auto& [target, bytes] : files) {
+      throwIfCancelled(spec.cancel);
       current = &target;
       written.push_back(std::make_unique<AtomicFile>(target));
       written.back()->write(*bytes);
       written.back()->close(true);
     }
+    if (spec.committing) spec.committing(true);
+    struct EndCommit {
+      const ConvertSpec& spec;
+      ~EndCommit() {
+        if (spec.committing) spec.committing(false);
+      }
+    } endCommit{spec};
+    throwIfCancelled(spec.cancel);
     for (const std::unique_ptr<AtomicFile>& file : written) {
       current = &file->target();
       file->commit();
@@ -91,20 +132,31 @@ ConvertResult convertScene(const ConvertSpec& spec) {
     result.warnings = std::move(loaded.warnings);
     result.objects = parsed.description.count(EntityKind::ObjectEntity);
     result.lights = parsed.description.count(EntityKind::LightEntity);
+    SceneWriteOptions write;
+    write.sourceName = spec.scene.filename().string();
+    const WrittenScene written = writeSceneYaml(parsed.description, result.output, write);
+    // An included file, a mesh or a texture named as the output would be replaced by the scene
+    // that reads it.
+    if (readByScene(result.output, written.inputs)) {
+      throw JobError(JobFailure::BadInput,
+                     fmt::format("{}: the scene being converted reads this file; choose another "
+                                 "name",
+                                 result.output.string()));
+    }
+    fs::path folder = result.output.parent_path();
+    std::vector<std::pair<fs::path, const std::string*>> files;
+    for (const WrittenScene::File& file : written.files) {
+      files.emplace_back(folder / file.name, &file.bytes);
+      checkTarget(files.back().first);
+    }
+    files.emplace_back(result.output, &written.yaml);
+    writeAllOrNothing(files, spec);
+    for (std::size_t i = 0; i + 1 < files.size(); ++i) result.meshFiles.push_back(files[i].first);
   } catch (const SceneError& error) {
     throw JobError(error);
+  } catch (const Cancelled&) {
+    result.interrupted = true;
   }
-  SceneWriteOptions write;
-  write.sourceName = spec.scene.filename().string();
-  const WrittenScene written = writeSceneYaml(parsed.description, result.output, write);
-  fs::path folder = result.output.parent_path();
-  std::vector<std::pair<fs::path, const std::string*>> files;
-  for (const WrittenScene::File& file : written.files) {
-    files.emplace_back(folder / file.name, &file.bytes);
-  }
-  files.emplace_back(result.output, &written.yaml);
-  writeAllOrNothing(files);
-  for (std::size_t i = 0; i + 1 < files.size(); ++i) result.meshFiles.push_back(files[i].first);
   return result;
 }
 

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -15,9 +16,12 @@ namespace glint {
 
 struct ConvertSpec {
   std::filesystem::path scene;   // the file to convert
-  std::filesystem::path output;  // .yaml (or .yml, .json); empty: the scene's name with .yaml,
+  std::filesystem::path output;  // .yaml or .yml (any case); empty: the scene's name with .yaml,
                                  // in the current folder
   const std::atomic<bool>* cancel = nullptr;  // not owned; may be null
+  // True while the written files are renamed over their targets, false when done: the caller
+  // should not end the process abruptly then (RenderJobEvents::committing likewise).
+  std::function<void(bool)> committing;
 };
 
 struct ConvertResult {
@@ -26,11 +30,14 @@ struct ConvertResult {
   std::vector<Diagnostic> warnings;              // of the scene, as render reports them
   std::size_t objects = 0;
   std::size_t lights = 0;
+  bool interrupted = false;  // the cancel flag was seen: nothing was written
 };
 
 // Reads and checks the scene (the errors `glint check` reports), then writes the YAML and its PLY
-// files, each atomically. Throws JobError: a bad scene, an output that is not .yaml/.yml/.json or
-// whose folder is missing, the output being the scene itself (exit status 2); a failed write (1).
+// files, all or none (each to a temporary file, then all renamed). Throws JobError: a bad scene,
+// an output that is not .yaml/.yml, is a folder or whose folder is missing, the output being the
+// scene itself or a file it reads (exit status 2); a failed write (1). Existing files of the PLY
+// names (OUTPUT-STEM_mesh1.ply, ...) are replaced.
 ConvertResult convertScene(const ConvertSpec& spec);
 
 }  // namespace glint

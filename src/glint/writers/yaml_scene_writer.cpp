@@ -1,5 +1,6 @@
 #include "glint/writers/yaml_scene_writer.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdint>
 #include <cstring>
@@ -40,8 +41,14 @@ class Writer {
   void write() {
     std::string& y = out_.yaml;
     if (!options_.sourceName.empty()) {
-      y += fmt::format("# glint scene converted by `glint convert` from {}\n", options_.sourceName);
+      // A comment ends at a line break: one in the file's name would start a line of YAML.
+      std::string name = options_.sourceName;
+      for (char& c : name) {
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+      }
+      y += fmt::format("# glint scene converted by `glint convert` from {}\n", name);
     }
+    collectInputs();
     const SourceFile& main = *scene_.files.at(0);
     if (scene_.name != kNoValue) {
       y += "name: " + yamlScalar(main.values.scalar(scene_.name)) + "\n";
@@ -86,8 +93,8 @@ class Writer {
     for (const Entity& e : scene_.entities) {
       if (e.kind != kind) continue;
       out_.yaml += "  - ";
+      rebaseFiles(e, e.value);  // also the texture files of a mesh written as PLY
       if (kind == EntityKind::ObjectEntity && asPly(e)) continue;
-      rebaseFiles(e, e.value);
       const std::string flow = this->flow(e, e.value);
       out_.yaml += flow.size() + 4 <= kFlowWidth ? flow : block(e, e.value, 4, true);
       out_.yaml += "\n";
@@ -152,7 +159,15 @@ class Writer {
         }
       }
     } else if (t.isList(v)) {
-      for (std::size_t i = 0; i < t.size(v); ++i) line(i, "- " + flow(e, t.item(v, i)));
+      for (std::size_t i = 0; i < t.size(v); ++i) {
+        const ValueId item = t.item(v, i);
+        const std::string f = flow(e, item);
+        if (t.isScalar(item) || f.size() + 2 + static_cast<std::size_t>(indent) <= kFlowWidth) {
+          line(i, "- " + f);
+        } else {
+          line(i, "- " + block(e, item, indent + 2, true));
+        }
+      }
     } else {
       line(0, flow(e, v));
     }
@@ -160,13 +175,13 @@ class Writer {
     return s;
   }
 
-  // Every `file` in the entity's value, at any depth (a mesh object's file, an image texture's,
-  // inline or named, an image background's), written relative to the folder of the file that
-  // names it: the same file from the output's folder.
-  void rebaseFiles(const Entity& e, ValueId v) {
+  // Calls visit(value) for every `file` in the entity's value, at any depth (a mesh object's file,
+  // an image texture's, inline or named, an image background's).
+  template <class Visit>
+  void forEachFile(const Entity& e, ValueId v, const Visit& visit) const {
     const ValueTree& t = tree(e);
     if (t.isList(v)) {
-      for (std::size_t i = 0; i < t.size(v); ++i) rebaseFiles(e, t.item(v, i));
+      for (std::size_t i = 0; i < t.size(v); ++i) forEachFile(e, t.item(v, i), visit);
       return;
     }
     if (!t.isMap(v)) return;
@@ -174,23 +189,59 @@ class Writer {
       const ValueId key = t.key(v, i);
       const ValueId value = t.value(v, i);
       if (t.isScalar(key) && t.scalar(key) == "file" && t.isScalar(value)) {
-        rebase(e, value);
+        visit(value);
       } else {
-        rebaseFiles(e, value);
+        forEachFile(e, value, visit);
       }
     }
   }
 
-  void rebase(const Entity& e, ValueId file) {
+  // The absolute path a `file` value of the entity names.
+  std::filesystem::path fileTarget(const Entity& e, ValueId file) const {
     const std::filesystem::path written(std::string(tree(e).scalar(file)));
-    if (written.is_absolute()) return;
+    if (written.is_absolute()) return written.lexically_normal();
+    return std::filesystem::absolute(scene_.fileOf(e).baseDirectory / written).lexically_normal();
+  }
+
+  // Every file the scene reads: the scene's own files (the included ones by their paths) and
+  // every file a value names. The PLY files written must not replace one of them.
+  void collectInputs() {
+    for (std::size_t i = 1; i < scene_.files.size(); ++i) {
+      out_.inputs.push_back(std::filesystem::absolute(scene_.files[i]->name).lexically_normal());
+    }
+    for (const Entity& e : scene_.entities) {
+      forEachFile(e, e.value, [&](ValueId file) { out_.inputs.push_back(fileTarget(e, file)); });
+    }
+  }
+
+  // Every `file` in the entity's value written relative to the output's folder: the same file as
+  // seen from the folder of the file that names it.
+  void rebaseFiles(const Entity& e, ValueId v) {
+    forEachFile(e, v, [&](ValueId file) {
+      if (std::filesystem::path(std::string(tree(e).scalar(file))).is_absolute()) return;
+      namespace fs = std::filesystem;
+      const fs::path target = fileTarget(e, file);
+      fs::path folder = output_.parent_path();
+      if (folder.empty()) folder = ".";
+      const fs::path relative = target.lexically_relative(fs::absolute(folder).lexically_normal());
+      replaced_[file] = relative.empty() ? target.string() : relative.generic_string();
+    });
+  }
+
+  // The name of the next PLY file: the output's stem, "_mesh" and a number, skipping any name
+  // the scene reads (converting a scene whose mesh files are named so must not replace them).
+  std::string nextPlyName() {
     namespace fs = std::filesystem;
-    const fs::path target =
-        fs::absolute(scene_.fileOf(e).baseDirectory / written).lexically_normal();
     fs::path folder = output_.parent_path();
     if (folder.empty()) folder = ".";
-    const fs::path relative = target.lexically_relative(fs::absolute(folder).lexically_normal());
-    replaced_[file] = relative.empty() ? target.string() : relative.generic_string();
+    while (true) {
+      ++plyNumber_;
+      std::string name = fmt::format("{}_mesh{}.ply", output_.stem().string(), plyNumber_);
+      const fs::path target = fs::absolute(folder / name).lexically_normal();
+      if (std::find(out_.inputs.begin(), out_.inputs.end(), target) == out_.inputs.end()) {
+        return name;
+      }
+    }
   }
 
   // An inline mesh large enough for a PLY file: written, and its YAML entry names the file.
@@ -219,13 +270,17 @@ class Writer {
       mesh.normals = numbers(normals);
     }
     for (const double i : numbers(indices)) mesh.indices.push_back(static_cast<std::uint32_t>(i));
-    ++plyFiles_;
-    const std::string name = fmt::format("{}_mesh{}.ply", output_.stem().string(), plyFiles_);
+    const std::string name = nextPlyName();
     out_.files.push_back({name, binaryPly(mesh)});
     std::string s = "{type: mesh, file: " + yamlScalar(name);
+    // An inline mesh without normals is flat whatever its `smooth` says; a mesh file without
+    // normals would get generated ones.
+    const bool flat = mesh.normals.empty();
+    if (flat) s += ", smooth: false";
     for (std::size_t i = 0; i < t.size(e.value); ++i) {
       const std::string_view key = t.scalar(t.key(e.value, i));
       if (key == "type" || key == "positions" || key == "normals" || key == "indices") continue;
+      if (flat && key == "smooth") continue;
       s += ", " + std::string(key) + ": " + flow(e, t.value(e.value, i));
     }
     out_.yaml += s + "}\n";
@@ -236,7 +291,7 @@ class Writer {
   const std::filesystem::path& output_;
   const SceneWriteOptions& options_;
   WrittenScene& out_;
-  std::size_t plyFiles_ = 0;
+  std::size_t plyNumber_ = 0;
   std::map<ValueId, std::string> replaced_;  // scalars written with another text
 };
 
@@ -245,7 +300,16 @@ class Writer {
 std::string yamlScalar(std::string_view text) {
   if (plainWord(text)) return std::string(text);
   std::string s = "\"";
-  for (const char c : text) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    // C1 control characters (U+0080 to U+009F: 0xC2 0x80–0x9F in UTF-8), which the reader refuses
+    // written as they are, escaped like the C0 ones.
+    const auto next = i + 1 < text.size() ? static_cast<unsigned char>(text[i + 1]) : 0u;
+    if (static_cast<unsigned char>(c) == 0xC2 && next >= 0x80 && next <= 0x9F) {
+      s += fmt::format("\\u{:04x}", next);
+      ++i;
+      continue;
+    }
     switch (c) {
       case '"':
         s += "\\\"";
@@ -260,7 +324,7 @@ std::string yamlScalar(std::string_view text) {
         s += "\\t";
         break;
       default:
-        if (static_cast<unsigned char>(c) < 0x20) {
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
           s += fmt::format("\\x{:02x}", static_cast<unsigned char>(c));
         } else {
           s += c;

@@ -28,10 +28,14 @@ struct WrittenScene {
     std::string bytes;
   };
   std::vector<File> files;
+  // Every file the scene reads (its included files, the files its values name), absolute: none
+  // of them may be written over.
+  std::vector<std::filesystem::path> inputs;
 };
 
 // The YAML of `scene` for a file at `output`: relative mesh paths are rewritten to resolve from
-// output's folder; PLY files are named after output's stem (scene_mesh1.ply, ...).
+// output's folder; PLY files are named after output's stem (scene_mesh1.ply, ...), skipping names
+// of files the scene reads.
 WrittenScene writeSceneYaml(const SceneDescription& scene, const std::filesystem::path& output,
                             const SceneWriteOptions& options = {});
 
