@@ -206,14 +206,29 @@ bool usesUv(const Texture& texture) {
          std::holds_alternative<ImageTexture>(texture);
 }
 
+namespace {
+
+// The solid checker's cell index along one axis: floor(x / scale), except that a coordinate within
+// 10^-12 (relative) of a cell boundary counts as on it. A face lying on a boundary (a unit box's
+// sides under a checker of scale 0.5) is hit exactly on it when the box is untransformed, but a
+// transformed one's hit point comes back through the inverse transform with an error of a few
+// ulps either side, and floor alone then flips between the two cells from pixel to pixel.
+double checkerCell(double offset, double scale) {
+  const double x = tame(offset / scale);
+  const double boundary = std::nearbyint(x);
+  if (std::abs(x - boundary) <= 1e-12 * std::max(1.0, std::abs(x))) return boundary;
+  return std::floor(x);
+}
+
+}  // namespace
+
 Color evaluate(const Texture& texture, const TextureLookup& at) {
   if (const auto* t = std::get_if<ImageTexture>(&texture)) return evaluateImage(*t, at);
   if (const auto* t = std::get_if<CheckerTexture>(&texture)) {
     const Point3& p = at.objectPoint;
     const Point3& c = t->center;
-    const double cells = std::floor(tame((p.x - c.x) / t->scale)) +
-                         std::floor(tame((p.y - c.y) / t->scale)) +
-                         std::floor(tame((p.z - c.z) / t->scale));
+    const double cells = checkerCell(p.x - c.x, t->scale) + checkerCell(p.y - c.y, t->scale) +
+                         checkerCell(p.z - c.z, t->scale);
     return t->colors[std::fmod(std::abs(cells), 2.0) == 1 ? 1 : 0];
   }
   if (const auto* t = std::get_if<Checker2dTexture>(&texture)) return evaluateChecker2d(*t, at);

@@ -102,6 +102,30 @@ TEST(Texture, SolidCheckerAtCellCentres) {
   }
 }
 
+// A point a few ulps off a cell boundary (a transformed face on it, its hit point brought back
+// through the inverse transform) takes the boundary's cell, as the exact point does: the face
+// is one colour, not speckled with both.
+TEST(Texture, SolidCheckerPointsWithinRoundingOfABoundaryTakeItsCell) {
+  const Texture t = CheckerTexture{{Color(0.1), Color(0.9)}, 0.5, Point3{}};
+  const auto colorAt = [&](double x) { return evaluate(t, {Point3{x, 0.25, 0.25}, {}, {}, {}}).r; };
+  for (const double boundary : {1.0, -1.0, 0.0, 1e6 + 0.5}) {
+    const double exact = colorAt(boundary);
+    double below = boundary;
+    double above = boundary;
+    for (int ulps = 1; ulps <= 4; ++ulps) {
+      below = std::nextafter(below, -HUGE_VAL);
+      above = std::nextafter(above, HUGE_VAL);
+      EXPECT_EQ(colorAt(below), exact) << boundary << " - " << ulps << " ulps";
+      EXPECT_EQ(colorAt(above), exact) << boundary << " + " << ulps << " ulps";
+    }
+    // A millionth of a cell away (near the origin) is the cell it is in.
+    if (std::abs(boundary) <= 1) {
+      EXPECT_NE(colorAt(boundary - 0.5e-6), exact) << boundary;
+      EXPECT_EQ(colorAt(boundary + 0.5e-6), exact) << boundary;
+    }
+  }
+}
+
 TEST(Texture, Checker2dAppliesRepeatOffsetAndRotation) {
   UvTransform transform;
   transform.repeat = {4, 2};
