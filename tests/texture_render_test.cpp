@@ -461,6 +461,12 @@ TEST(TextureRender, TextureFilesAreCheckedAndBudgeted) {
                                    "{ kd: { type: image, file: two.png } } }\n",
                           folder, filmBytes(4, 4) + 30),
               HasSubstr("more than the memory limit"));
+  // ... and the moment it is decoded needs 8 bytes a pixel more (32 here): room for the mip-maps
+  // alone is not enough.
+  EXPECT_THAT(sceneErrors(header + "  - { type: sphere, center: [0, 0, 0], radius: 1, material: "
+                                   "{ kd: { type: image, file: two.png } } }\n",
+                          folder, filmBytes(4, 4) + 60 + 16),
+              HasSubstr("(and 32 B more while it is decoded)"));
   // The same file twice (and under another spelling) is decoded once.
   const LoadedScene twice = loadSceneFromString(
       header +
