@@ -479,5 +479,44 @@ TEST(TextureRender, TextureFilesAreCheckedAndBudgeted) {
   EXPECT_EQ(first.get(), second.get());
 }
 
+// An EXR or HDR file holds linear values: `encoding: srgb` on one changes nothing, and says so at
+// the key (a texture and the sky); the default encoding or `linear` says nothing, nor does srgb on
+// a PNG.
+TEST(TextureRender, SrgbEncodingOfALinearFileIsAWarning) {
+  const fs::path folder = scratchFolder() / "linear-files";
+  fs::create_directories(folder);
+  writeTwoByTwo(folder);
+  fs::copy_file(fs::path(GLINT_SOURCE_DIR) / "scenes" / "textures" / "sky.hdr", folder / "sky.hdr",
+                fs::copy_options::overwrite_existing);
+  const std::string header =
+      "camera: { position: [0, 0, 3], direction: [0, 0, -1], fov: 40 }\n"
+      "image: { width: 4, height: 4 }\n";
+  const auto warningsOf = [&](const std::string& text) {
+    std::vector<std::string> lines;
+    for (const Diagnostic& d : loadSceneFromString(header + text, "test.yaml", folder).warnings) {
+      lines.push_back(d.format());
+    }
+    return lines;
+  };
+  const std::string sphere = "objects:\n  - { type: sphere, center: [0, 0, 0], radius: 1, ";
+  EXPECT_THAT(warningsOf("background: { type: image, file: sky.hdr, encoding: srgb }\n"),
+              testing::ElementsAre(
+                  HasSubstr("test.yaml:3:53: warning: encoding: srgb has no effect on 'sky.hdr'")));
+  EXPECT_THAT(warningsOf(sphere + "material: { kd: { type: image, file: sky.hdr, encoding: srgb } "
+                                  "} }\nlights: [{ type: point, position: [0, 0, 3] }]\n"),
+              testing::ElementsAre(HasSubstr("test.yaml:4:107: warning: encoding: srgb has no "
+                                             "effect on 'sky.hdr': an EXR or HDR file holds "
+                                             "linear values")));
+  for (const char* quiet : {"{ type: image, file: sky.hdr }",
+                            "{ type: image, file: sky.hdr, "
+                            "encoding: linear }",
+                            "{ type: image, file: two.png, encoding: srgb }"}) {
+    EXPECT_THAT(warningsOf(sphere + "material: { kd: " + quiet +
+                           " } }\nlights: [{ type: point, position: [0, 0, 3] }]\n"),
+                testing::IsEmpty())
+        << quiet;
+  }
+}
+
 }  // namespace
 }  // namespace glint

@@ -291,16 +291,19 @@ void buildEnvironment(const ValueReader& reader, const Entity& e, BuildContext& 
       environment.sinRotate = std::sin(radians);
     }
     ImageEncoding encoding = ImageEncoding::Srgb;
+    ValueId srgbGiven = kNoValue;
     if (const auto text = p.text("encoding")) {
       if (text->value == "linear") {
         encoding = ImageEncoding::Linear;
-      } else if (text->value != "srgb") {
+      } else if (text->value == "srgb") {
+        srgbGiven = text->where;
+      } else {
         p.error(text->where, fmt::format("background.encoding: expected srgb or linear, got {}",
                                          quoteForMessage(text->value)));
       }
     }
     if (file && p.errors() == 0 && ctx.textures != nullptr) {
-      environment.image = ctx.textures->image(p, file->where, file->value, encoding);
+      environment.image = ctx.textures->image(p, file->where, file->value, encoding, srgbGiven);
     }
   } else {
     if (type) {

@@ -132,9 +132,11 @@ std::optional<Texture> readImage(ParameterDictionary& p, const TextureReadContex
   }
   ImageEncoding encoding =
       ctx.role == TextureRole::Color ? ImageEncoding::Srgb : ImageEncoding::Linear;
+  ValueId srgbGiven = kNoValue;
   if (const auto e = p.text("encoding")) {
     if (e->value == "srgb") {
       encoding = ImageEncoding::Srgb;
+      srgbGiven = e->where;
     } else if (e->value == "linear") {
       encoding = ImageEncoding::Linear;
     } else {
@@ -145,7 +147,7 @@ std::optional<Texture> readImage(ParameterDictionary& p, const TextureReadContex
   const auto transform = readUvTransform(p, Point2{1, 1});
   if (!file || !transform || p.errors() != 0 || ctx.images == nullptr) return std::nullopt;
   t.transform = *transform;
-  t.image = ctx.images->image(p, file->where, file->value, encoding);
+  t.image = ctx.images->image(p, file->where, file->value, encoding, srgbGiven);
   if (t.image == nullptr) return std::nullopt;
   return t;
 }

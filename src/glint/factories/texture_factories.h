@@ -24,8 +24,11 @@ enum class TextureRole : std::uint8_t { Color, Data };
 class ImageSource {
  public:
   virtual ~ImageSource() = default;
+  // `srgbGiven`: where the scene asks for sRGB decoding in so many words (`encoding: srgb`), or
+  // kNoValue; on a file whose values are linear (EXR, HDR) that has no effect, and is a warning.
   virtual std::shared_ptr<const MipMap> image(ParameterDictionary& params, ValueId where,
-                                              std::string_view file, ImageEncoding encoding) = 0;
+                                              std::string_view file, ImageEncoding encoding,
+                                              ValueId srgbGiven = kNoValue) = 0;
 };
 
 struct TextureReadContext {

@@ -219,10 +219,13 @@ std::shared_ptr<const MipMap> TextureLibrary::load(const std::filesystem::path& 
   if (error) key = path.lexically_normal();
   auto& slot = images_[{key.string(), encoding}];
   if (slot != nullptr) return slot;
+  bool floatingPoint = false;
   RgbImage decoded = readImageFile(path, encoding, [&](const ImageHeader& header) {
     checkBudget(header, fmt::format("its {}", formatName(header.format)));
+    floatingPoint = header.floatingPoint;
   });
   auto image = std::make_shared<const MipMap>(std::move(decoded));
+  if (floatingPoint) linearFiles_.insert(image.get());
   bytes_ += static_cast<double>(image->memoryBytes());
   ++filesDecoded_;
   slot = image;
@@ -237,6 +240,7 @@ std::shared_ptr<const MipMap> TextureLibrary::loadEmbedded(const std::string& ke
   const ImageHeader header = readImageHeader(bytes);
   checkBudget(header, fmt::format("its embedded {}", formatName(header.format)));
   auto image = std::make_shared<const MipMap>(decodeImage(bytes, encoding));
+  if (header.floatingPoint) linearFiles_.insert(image.get());
   bytes_ += static_cast<double>(image->memoryBytes());
   ++filesDecoded_;
   slot = image;
@@ -244,11 +248,19 @@ std::shared_ptr<const MipMap> TextureLibrary::loadEmbedded(const std::string& ke
 }
 
 std::shared_ptr<const MipMap> TextureLibrary::image(ParameterDictionary& params, ValueId where,
-                                                    std::string_view file, ImageEncoding encoding) {
+                                                    std::string_view file, ImageEncoding encoding,
+                                                    ValueId srgbGiven) {
   const std::filesystem::path written(file);
   const std::filesystem::path path = written.is_relative() ? folderOf(params) / written : written;
   try {
-    return load(path, encoding);
+    std::shared_ptr<const MipMap> image = load(path, encoding);
+    if (srgbGiven != kNoValue && linearFiles_.contains(image.get())) {
+      ctx_.sink.warning(params.location(srgbGiven),
+                        fmt::format("encoding: srgb has no effect on '{}': an EXR or HDR file "
+                                    "holds linear values, which are used as they are",
+                                    escapeForMessage(file)));
+    }
+    return image;
   } catch (const ImageReadError& e) {
     std::string reason = e.what();
     if (path != written && reason == "no such file") {

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -66,7 +67,8 @@ class TextureLibrary : public ImageSource {
 
   // ImageSource: the file at a texture's `file` value, errors reported there.
   std::shared_ptr<const MipMap> image(ParameterDictionary& params, ValueId where,
-                                      std::string_view file, ImageEncoding encoding) override;
+                                      std::string_view file, ImageEncoding encoding,
+                                      ValueId srgbGiven = kNoValue) override;
 
  private:
   std::optional<TextureId> readInline(ParameterDictionary& params,
@@ -77,13 +79,17 @@ class TextureLibrary : public ImageSource {
   std::filesystem::path folderOf(const ParameterDictionary& params) const;
   // Refuses a width × height image whose mip-map would pass the budget (before decoding).
   void checkBudget(const ImageHeader& header, const std::string& shown);
+  // The images decoded from floating-point files (EXR, HDR), whose values are linear whatever
+  // the encoding asked for.
+  std::set<const MipMap*> linearFiles_;
 
   const SceneDescription& scene_;
   BuildContext& ctx_;
   std::function<double()> otherBytes_;
   // name → its texture, or nullopt when its definition was wrong (so uses are not reported again).
   std::map<std::string, std::optional<TextureId>, std::less<>> named_;
-  std::map<std::string, std::pair<std::uint32_t, TextPosition>, std::less<>> namedWhere_;  // file, place
+  std::map<std::string, std::pair<std::uint32_t, TextPosition>, std::less<>>
+      namedWhere_;  // file, place
   std::map<std::pair<std::string, ImageEncoding>, std::shared_ptr<const MipMap>> images_;
   double bytes_ = 0;
   std::size_t filesDecoded_ = 0;
