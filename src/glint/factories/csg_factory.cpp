@@ -97,8 +97,10 @@ std::optional<Csg> readOperand(const ValueReader& reader, ValueId value, ValueId
   params.declare(isCsg ? kCsgKeys : factory->keys);
   params.declare({"material", "emission", "transform"});
   if (const auto own = services.material(params, path)) {
-    material = *own;
+    material = own->index;
     if (services.emissionTexture) emission = Color();
+    // The operand's material's emission, unless the operand gives its own.
+    if (own->emission) emission = *own->emission;
   }
   if (params.has("emission")) {
     if (const auto own = readCoefficient(params, "emission", services.encoding)) emission = *own;

@@ -20,9 +20,14 @@ namespace glint {
 
 // What the scene builder lends the csg factory for an operand's shared keys.
 struct CsgServices {
-  // The material an operand's `material` key names (or defines inline), nullopt without the key;
-  // errors reported. owner: the operand's path ("csg.operands[1]").
-  std::function<std::optional<std::uint32_t>(ParameterDictionary&, const std::string& owner)>
+  // The material an operand's `material` key names (or defines inline), with the material's
+  // `emission` if it has one; nullopt without the key; errors reported. owner: the operand's path
+  // ("csg.operands[1]").
+  struct OperandMaterial {
+    std::uint32_t index = 0;
+    std::optional<Color> emission;
+  };
+  std::function<std::optional<OperandMaterial>(ParameterDictionary&, const std::string& owner)>
       material;
   // A mesh operand's contents (its file through the scene's mesh cache, or its inline arrays);
   // null after an error (reported).

@@ -20,12 +20,13 @@ const std::vector<std::string_view>& materialKeys() {
                                                      "priority",
                                                      "normal_map",
                                                      "bump_map",
-                                                     "bump_scale"};
+                                                     "bump_scale",
+                                                     "emission"};
   return keys;
 }
 
 std::optional<Material> readMaterial(ParameterDictionary& params, Encoding encoding,
-                                     TextureLibrary* textures) {
+                                     TextureLibrary* textures, std::optional<Color>* emission) {
   params.declare(materialKeys());
   const std::size_t errorsBefore = params.errors();
   Material out;
@@ -49,6 +50,13 @@ std::optional<Material> readMaterial(ParameterDictionary& params, Encoding encod
   coefficient("kr", out.kr, bindings.kr);
   coefficient("kt", out.kt, bindings.kt);
   coefficient("ka", out.ka, bindings.ka);
+  if (params.has("emission")) {
+    // The emission of the objects that name this material and give none of their own; a texture
+    // is carried by the material's bindings, as an object's emission texture is, the constant 1.
+    Color value;
+    coefficient("emission", value, bindings.emission);
+    if (emission != nullptr) *emission = value;
+  }
   if (const auto v = readPositive(params, "ior")) out.ior = *v;
   if (const auto v = readNonNegative(params, "reflection_blur")) out.reflectionBlur = *v;
   if (const auto v = readNonNegative(params, "refraction_blur")) out.refractionBlur = *v;

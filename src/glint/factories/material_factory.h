@@ -22,8 +22,11 @@ class TextureLibrary;
 // a colour key may name or describe a texture (its constant is then 1, the texture's colour
 // replacing it), and normal_map, bump_map and bump_scale are read; the bindings are added to the
 // scene and indexed by Material::textures. A colour written "#rrggbb" is decoded under `encoding`
-// (the image's, as every display colour of the scene).
+// (the image's, as every display colour of the scene). `emission` (may be null) receives the
+// material's `emission` when it has one: a colour, or 1 with the texture in the bindings (DESIGN.md
+// §9: the emission of the objects naming the material that give none of their own).
 std::optional<Material> readMaterial(ParameterDictionary& params, Encoding encoding,
-                                     TextureLibrary* textures = nullptr);
+                                     TextureLibrary* textures = nullptr,
+                                     std::optional<Color>* emission = nullptr);
 
 }  // namespace glint

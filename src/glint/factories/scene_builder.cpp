@@ -48,6 +48,7 @@ const ObjectFactory kInstanceFactory{"instance", {"group"}, nullptr};
 struct MaterialChoice {
   std::uint32_t index = 0;  // into SceneParts::materials; 0 = the default material
   bool given = false;       // a name or an inline mapping (a mesh then ignores its file's own)
+  std::optional<Color> emission;  // the material's `emission`, if it has one
 };
 
 class Builder {
@@ -144,12 +145,14 @@ class Builder {
     auto params = entityParameters(reader, e.value, e.name,
                                    "a mapping of material keys (kd, ks, shininess, kr, kt, ka, "
                                    "ior, reflection_blur, refraction_blur, priority, normal_map, "
-                                   "bump_map, bump_scale)",
+                                   "bump_map, bump_scale, emission)",
                                    {"in material '" + name + "'", path, path});
     std::optional<Material> material;
     if (params) {
-      material = readMaterial(*params, ctx_.encoding, &textures_);
+      std::optional<Color> emission;
+      material = readMaterial(*params, ctx_.encoding, &textures_, &emission);
       params->finish();
+      if (material && emission) materialEmission_[index] = *emission;
     }
     // Kept even when it has errors, so objects naming it do not also report it undefined.
     parts_.materials.push_back(material.value_or(Material{}));
@@ -163,11 +166,13 @@ class Builder {
     if (tree.isMap(entry->value)) {
       const std::string path = owner + ".material";
       ParameterDictionary inline_(reader, entry->value, {"in " + path, path, path});
-      const std::optional<Material> material = readMaterial(inline_, ctx_.encoding, &textures_);
+      std::optional<Color> emission;
+      const std::optional<Material> material =
+          readMaterial(inline_, ctx_.encoding, &textures_, &emission);
       inline_.finish();
-      if (!material) return {0, true};
+      if (!material) return {0, true, std::nullopt};
       parts_.materials.push_back(*material);
-      return {static_cast<std::uint32_t>(parts_.materials.size() - 1), true};
+      return {static_cast<std::uint32_t>(parts_.materials.size() - 1), true, emission};
     }
     if (!tree.isScalar(entry->value)) {
       params.error(entry->where, fmt::format("{}.material: expected a material name or a mapping "
@@ -177,7 +182,10 @@ class Builder {
     }
     const std::string_view name = tree.scalar(entry->value);
     if (const auto it = materialIndex_.find(name); it != materialIndex_.end()) {
-      return {it->second, true};
+      const auto emission = materialEmission_.find(it->second);
+      return {it->second, true,
+              emission != materialEmission_.end() ? std::optional<Color>(emission->second)
+                                                  : std::nullopt};
     }
     std::vector<std::string> names;
     for (const auto& [n, index] : materialIndex_) names.push_back(n);
@@ -188,7 +196,7 @@ class Builder {
     }
     params.error(entry->where, fmt::format("{}.material: undefined material '{}'{}", owner,
                                            escapeForMessage(name), hint));
-    return {0, true};
+    return {0, true, std::nullopt};
   }
 
   // --- objects --------------------------------------------------------------------------------
@@ -395,7 +403,7 @@ class Builder {
     params.declare({"material", "emission", "transform"});
 
     MaterialChoice material = resolveMaterial(params, type);
-    const bool hasEmission = params.has("emission");
+    bool hasEmission = params.has("emission");
     // `emission` is a colour (or a number, grey), or a texture: then the object's own copy of its
     // material carries it and the constant is 1.
     std::optional<Color> emission;
@@ -405,6 +413,16 @@ class Builder {
       if (emissionTexture) emission = Color(1);
     } else {
       emission = readCoefficient(params, "emission", ctx_.encoding);
+    }
+    if (material.emission) {
+      if (!hasEmission) {
+        // The material's emission (its texture, if any, is in the material's bindings).
+        emission = material.emission;
+        hasEmission = true;
+      } else if (!emissionTexture && hasEmissionTexture(material.index)) {
+        // The object's own emission colour replaces the material's emission texture too.
+        material.index = withEmissionTexture(material.index, kNoTexture);
+      }
     }
     const TransformResult transform = readTransform(params, type);
     if (factory == &csgFactory_) {
@@ -454,9 +472,11 @@ class Builder {
                 const TransformResult& transform) {
     if (emissionTexture) material.index = withEmissionTexture(material.index, *emissionTexture);
     CsgServices services{
-        [this](ParameterDictionary& p, const std::string& owner) -> std::optional<std::uint32_t> {
+        [this](ParameterDictionary& p,
+               const std::string& owner) -> std::optional<CsgServices::OperandMaterial> {
           if (!p.has("material")) return std::nullopt;
-          return resolveMaterial(p, owner).index;
+          const MaterialChoice choice = resolveMaterial(p, owner);
+          return CsgServices::OperandMaterial{choice.index, choice.emission};
         },
         [this](ParameterDictionary& p, const MeshRequest& request) { return loadMesh(p, request); },
         ctx_.encoding, emissionTexture.has_value()};
@@ -481,8 +501,13 @@ class Builder {
     }
   }
 
+  bool hasEmissionTexture(std::uint32_t index) const {
+    const Material& m = parts_.materials[index];
+    return m.textures != kUntextured && parts_.materialTextures[m.textures].emission != kNoTexture;
+  }
+
   // A copy of material `index` whose emission is the texture `emission` (times the object's
-  // emission constant).
+  // emission constant; kNoTexture: none).
   std::uint32_t withEmissionTexture(std::uint32_t index, TextureId emission) {
     Material m = parts_.materials[index];
     MaterialTextures bindings =
@@ -859,6 +884,7 @@ class Builder {
   // `csg` has no entry in objectFactories(): its operands need the builder (materials, meshes).
   const ObjectFactory csgFactory_{"csg", kCsgKeys, nullptr};
   std::map<std::uint32_t, std::pair<std::uint32_t, TextPosition>> materialWhere_;  // file, place
+  std::map<std::uint32_t, Color> materialEmission_;  // named materials with an `emission`
   std::map<std::string, std::uint32_t, std::less<>> groupIndex_;    // into parts_.groups
   std::vector<std::optional<Bounds3>> groupBounds_;                 // groupBounds()
   std::vector<std::pair<std::uint32_t, TextPosition>> groupWhere_;  // per group: file, place

@@ -21,6 +21,7 @@
 
 #include "glint/factories/scene_loader.h"
 #include "glint/factories/scene_test_support.h"
+#include "glint/geometry/csg.h"
 #include "glint/readers/yaml_scene_reader.h"
 #include "glint/scene/scene.h"
 #include "glint/scene/scene_limits.h"
@@ -215,6 +216,47 @@ TEST(SceneBuilder, HexColorsDecodeUnderTheImageEncoding) {
     EXPECT_EQ(m.ka, Color(0.5, 0.25, 0));
     EXPECT_EQ(parts.primitives.at(0).emission(), Color(0.5));
   }
+}
+
+// A material's `emission` (DESIGN.md §9: a colour-valued material key) is the emission of every
+// object that names the material and gives none of its own: named or inline, a colour or a
+// texture, on shapes, meshes and csg operands; an object's own emission replaces it.
+TEST(SceneBuilder, AMaterialsEmissionIsItsObjectsEmission) {
+  const std::string scene =
+      std::string(kMinimal) +
+      "textures: {glow: {type: checker, colors: [[1, 0, 0], [0, 0, 1]]}}\n"
+      "materials:\n  lamp: {kd: 0.2, emission: [2, 1, 0.5]}\n  neon: {emission: glow}\n"
+      "objects:\n"
+      "  - {type: sphere, center: [0, 0, -5], radius: 1, material: lamp}\n"
+      "  - {type: sphere, center: [3, 0, -5], radius: 1, material: lamp, emission: 0.25}\n"
+      "  - {type: sphere, center: [6, 0, -5], radius: 1, material: {emission: \"#ff0000\"}}\n"
+      "  - {type: sphere, center: [9, 0, -5], radius: 1, material: neon}\n"
+      "  - {type: sphere, center: [12, 0, -5], radius: 1, material: neon, emission: [0, 1, 0]}\n"
+      "  - {type: sphere, center: [15, 0, -5], radius: 1}\n"
+      "  - {type: csg, operation: union, operands: [{type: sphere, center: [0, 5, -5], radius: "
+      "1, material: lamp}, {type: sphere, center: [1, 5, -5], radius: 1}]}\n";
+  const SceneParts p = partsOf(scene);
+  ASSERT_EQ(p.primitives.size(), 7u);
+  EXPECT_EQ(p.primitives[0].emission(), Color(2, 1, 0.5));
+  EXPECT_EQ(p.materials[p.primitives[0].materialIndex()].kd, Color(0.2));
+  EXPECT_EQ(p.primitives[1].emission(), Color(0.25));
+  EXPECT_EQ(p.primitives[2].emission(), Color(1, 0, 0));
+  const auto emissionTexture = [&](const Primitive& primitive) {
+    const Material& m = p.materials[primitive.materialIndex()];
+    return m.textures == kUntextured ? kNoTexture : p.materialTextures[m.textures].emission;
+  };
+  // A textured emission: the constant 1, the texture in the material's bindings.
+  EXPECT_EQ(p.primitives[3].emission(), Color(1));
+  EXPECT_NE(emissionTexture(p.primitives[3]), kNoTexture);
+  // The object's own colour replaces the material's texture.
+  EXPECT_EQ(p.primitives[4].emission(), Color(0, 1, 0));
+  EXPECT_EQ(emissionTexture(p.primitives[4]), kNoTexture);
+  EXPECT_EQ(p.primitives[5].emission(), Color());
+  // The csg's first operand glows with its material's emission, the second not at all.
+  const Csg& csg = std::get<Csg>(p.primitives[6].shape());
+  const auto emissionOfOperand = [&](std::size_t i) { return csg.tree->operands.at(i).emission; };
+  EXPECT_EQ(emissionOfOperand(0), Color(2, 1, 0.5));
+  EXPECT_EQ(emissionOfOperand(1), Color());
 }
 
 TEST(SceneBuilder, DefaultsForOptionalKeys) {
@@ -674,7 +716,7 @@ TEST(SceneBuilder, YamlMergeKeysShareMaterialsAndObjects) {
   EXPECT_EQ(errors[0].format(),
             "test.yaml:4:25: unknown key 'shinyness' in material 'base'; expected one of: kd, ks, "
             "shininess, kr, kt, ka, ior, reflection_blur, refraction_blur, priority, normal_map, "
-            "bump_map, bump_scale (did you mean 'shininess'?)");
+            "bump_map, bump_scale, emission (did you mean 'shininess'?)");
   EXPECT_THAT(errors[1].format(), HasSubstr("test.yaml:4:25: unknown key 'shinyness' in material "
                                             "'other'"));
 }
