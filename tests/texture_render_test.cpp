@@ -479,6 +479,28 @@ TEST(TextureRender, TextureFilesAreCheckedAndBudgeted) {
   EXPECT_EQ(first.get(), second.get());
 }
 
+// Maps of an MTL file that glint does not read are named in a warning at the mesh object, not
+// dropped in silence (their files need not exist: they are never opened).
+TEST(TextureRender, MtlMapsGlintDoesNotReadAreAWarning) {
+  const fs::path folder = scratchFolder() / "ignored-maps";
+  fs::create_directories(folder);
+  writeTwoByTwo(folder);
+  std::ofstream(folder / "quad.obj") << "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                        "vt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n";
+  std::ofstream(folder / "quad.mtl")
+      << "newmtl m\nKd 1 1 1\nmap_Kd two.png\nmap_Ka missing.png\nmap_d alpha.png\n";
+  const LoadedScene loaded = loadSceneFromString(
+      "camera: { position: [0, 0, 3], direction: [0, 0, -1], fov: 40 }\n"
+      "image: { width: 4, height: 4 }\nlights: [{ type: point, position: [0, 0, 3] }]\n"
+      "objects:\n  - { type: mesh, file: quad.obj }\n",
+      "test.yaml", folder);
+  ASSERT_EQ(loaded.warnings.size(), 1u);
+  EXPECT_EQ(loaded.warnings[0].format(),
+            "test.yaml:5:5: warning: mesh file 'quad.obj': its materials' map_Ka 'missing.png', "
+            "map_d 'alpha.png' are not used (glint reads map_Kd, map_Ks, map_Ke, map_Bump or "
+            "bump, and norm)");
+}
+
 // An EXR or HDR file holds linear values: `encoding: srgb` on one changes nothing, and says so at
 // the key (a texture and the sky); the default encoding or `linear` says nothing, nor does srgb on
 // a PNG.

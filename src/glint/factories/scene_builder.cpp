@@ -591,6 +591,17 @@ class Builder {
                                 named, file->droppedTriangles,
                                 file->droppedTriangles == 1 ? "" : "s", triangles));
     }
+    if (!file->ignoredTextures.empty()) {
+      std::vector<std::string> ignoredShown;
+      for (const std::string& ignored : file->ignoredTextures) {
+        ignoredShown.push_back(escapeForMessage(ignored));
+      }
+      sink_.warning(params.location(),
+                    fmt::format("{}: its materials' {} {} not used (glint reads map_Kd, map_Ks, "
+                                "map_Ke, map_Bump or bump, and norm)",
+                                named, fmt::join(ignoredShown, ", "),
+                                ignoredShown.size() == 1 ? "is" : "are"));
+    }
     return file;
   }
 

@@ -251,6 +251,31 @@ void convertTextures(const aiScene& scene, const aiMaterial& m, MeshMaterial& ou
   }
 }
 
+// Adds to `ignored` ("map_Ka 'wood.png'") the textures material `m` names that glint does not use:
+// an OBJ's ambient, opacity, shininess, reflection and displacement maps (assimp's texture types
+// for them; glTF's PBR maps come as other types, and the documentation says they are ignored).
+// At most kMaxIgnoredTextures entries, each named once.
+void noteIgnoredTextures(const aiMaterial& m, std::vector<std::string>& ignored) {
+  static constexpr std::pair<aiTextureType, const char*> kIgnored[] = {
+      {aiTextureType_AMBIENT, "map_Ka"},
+      {aiTextureType_OPACITY, "map_d"},
+      {aiTextureType_SHININESS, "map_Ns"},
+      {aiTextureType_REFLECTION, "refl"},
+      {aiTextureType_DISPLACEMENT, "disp"}};
+  for (const auto& [type, keyword] : kIgnored) {
+    for (unsigned i = 0; i < m.GetTextureCount(type); ++i) {
+      aiString path;
+      if (m.GetTexture(type, i, &path) != AI_SUCCESS) continue;
+      // Escaped by the renderer, which trusts nothing the reader sends.
+      std::string entry = fmt::format("{} '{}'", keyword, path.C_Str());
+      if (ignored.size() < kMaxIgnoredTextures &&
+          std::find(ignored.begin(), ignored.end(), entry) == ignored.end()) {
+        ignored.push_back(std::move(entry));
+      }
+    }
+  }
+}
+
 // `objDefined`: for an OBJ file, the names its MTL files define (else null).
 MeshMaterial convertMaterial(const aiMaterial& m, const std::set<std::string>* objDefined) {
   MeshMaterial out;
@@ -511,6 +536,7 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
               convertMaterial(*scene->mMaterials[source], objDefined ? &*objDefined : nullptr));
           convertTextures(*scene, *scene->mMaterials[source], result.materials.back(),
                           result.embeddedImages, embeddedFrom);
+          noteIgnoredTextures(*scene->mMaterials[source], result.ignoredTextures);
         }
         part.materialIndex = materialOf[source];
       } else {

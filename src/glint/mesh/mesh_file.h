@@ -131,9 +131,13 @@ struct MeshFile {
   // edge², the same bound as a scene's triangle), a non-finite vertex, or a vertex index out of
   // range.
   std::size_t droppedTriangles = 0;
+  // Textures the materials name that glint does not use, as "map_Ka 'wood.png'" (an OBJ's
+  // ambient, opacity, shininess, reflection and displacement maps): reported in a warning.
+  std::vector<std::string> ignoredTextures;  // at most kMaxIgnoredTextures
 
   std::size_t triangleCount() const;
 };
+inline constexpr std::size_t kMaxIgnoredTextures = 16;
 
 // How a mesh file is read, besides its path.
 struct MeshReadOptions {

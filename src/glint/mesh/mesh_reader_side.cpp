@@ -26,7 +26,11 @@ namespace wire {
 
 bool writeMeshFile(int fd, const MeshFile& file) {
   bool ok = writeValue(fd, 'M') && writeValue(fd, std::uint64_t{file.droppedTriangles}) &&
-            writeValue(fd, std::uint64_t{file.materials.size()});
+            writeValue(fd, std::uint64_t{file.ignoredTextures.size()});
+  for (const std::string& ignored : file.ignoredTextures) {
+    ok = ok && writeMessage(fd, 'I', ignored);
+  }
+  ok = ok && writeValue(fd, std::uint64_t{file.materials.size()});
   for (const MeshMaterial& m : file.materials) {
     ok = ok && writeMessage(fd, 'N', m.name) && writeValue(fd, m.material) &&
          writeValue(fd, m.emission) && writeValue(fd, static_cast<char>(m.fromFile));
