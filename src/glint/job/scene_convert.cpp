@@ -33,8 +33,9 @@ std::string lowercase(std::string text) {
   return text;
 }
 
-// A file the conversion writes (the scene or a PLY file) that cannot be one: exit status 2,
-// before the scene is even read.
+// Refuses, as a bad argument (exit status 2), a name the conversion cannot write a file under
+// (the output scene, checked before the scene is read, or a PLY file): a folder, a missing folder,
+// a name too long for the file system.
 void checkTarget(const fs::path& target) {
   std::error_code error;
   if (fs::is_directory(target, error)) {
