@@ -203,10 +203,11 @@ class Writer {
     return std::filesystem::absolute(scene_.fileOf(e).baseDirectory / written).lexically_normal();
   }
 
-  // Every file the scene reads: the scene's own files (the included ones by their paths) and
-  // every file a value names. The PLY files written must not replace one of them.
+  // Every file the scene reads: the scene's own files (the scene itself and the included ones,
+  // by their paths) and every file a value names. The PLY files written must not replace one of
+  // them (a bare mesh x_mesh1.ply converted to x.yaml).
   void collectInputs() {
-    for (std::size_t i = 1; i < scene_.files.size(); ++i) {
+    for (std::size_t i = 0; i < scene_.files.size(); ++i) {
       out_.inputs.push_back(std::filesystem::absolute(scene_.files[i]->name).lexically_normal());
     }
     for (const Entity& e : scene_.entities) {
