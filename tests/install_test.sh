@@ -58,9 +58,40 @@ cmake -S "$source/examples" -B "$work/examples" "${generator[@]}" -DCMAKE_BUILD_
   cat "$work/configure.log"
   fail "examples/ does not configure against the installed package"
 }
-cmake --build "$work/examples" -j "${GLINT_JOBS:-2}" --target seed_test_case
+# examples/CMakeLists.txt sets no C++ standard of its own: glint::glint must bring C++20.
+cmake --build "$work/examples" -j "${GLINT_JOBS:-2}" --target seed_test_case render_scene_file
 "$work/examples/seed_test_case" "$work/seed.png"
 "$build/examples/seed_test_case" "$work/seed-in-tree.png" >/dev/null
 cmp "$work/seed.png" "$work/seed-in-tree.png" ||
   fail "the example built against the installed package renders other bytes than the in-tree one"
 echo "ok: examples/ built against the installed glint renders the seed's test case"
+
+# A program of the library's user, in PREFIX/bin: a mesh scene (the installed mesh reader) to an
+# EXR image (the installed module), found from the program's place — never from the build tree,
+# which an installed library must not run helpers from.
+cp "$work/examples/render_scene_file" "$prefix/bin/"
+"$prefix/bin/render_scene_file" "$source/scenes/mesh.yaml" "$work/mesh-lib.exr" 96 >/dev/null ||
+  fail "a program linked with the installed library could not render scenes/mesh.yaml to EXR"
+"$prefix/bin/glint" render "$source/scenes/mesh.yaml" -o "$work/mesh-cmd.exr" --width 96 --quiet
+cmp "$work/mesh-lib.exr" "$work/mesh-cmd.exr" ||
+  fail "the library's program and the command render scenes/mesh.yaml to other EXR bytes"
+# Outside the prefix (and outside the build tree) the helpers are not found, and the error says
+# how to name them, unless glint was configured for an install prefix that holds them.
+if [[ ! -e /usr/local/libexec/glint/glint-mesh-reader && ! -e /usr/libexec/glint/glint-mesh-reader ]]; then
+  if "$work/examples/render_scene_file" "$source/scenes/mesh.yaml" "$work/nowhere.png" 32 \
+    >/dev/null 2>"$work/nowhere.log"; then
+    fail "a program outside the prefix found a mesh reader: the build tree's?"
+  fi
+  grep -q "GLINT_MESH_READER" "$work/nowhere.log" ||
+    fail "the missing mesh reader is not explained: $(cat "$work/nowhere.log")"
+fi
+echo "ok: a program linked with the installed library reads meshes and writes EXR"
+
+# Every installed header compiles on its own (no include order, no definition from the build).
+cxx="${CXX:-c++}"
+find "$prefix/include/glint" -name '*.h' -printf '%P\n' | sort |
+  xargs -P "${GLINT_JOBS:-2}" -I{} sh -c \
+    'echo "#include <glint/{}>" | "$0" -std=c++20 -fsyntax-only -I"$1/include" -x c++ - ||
+       { echo "FAIL: <glint/{}> does not compile on its own" >&2; exit 255; }' "$cxx" "$prefix" ||
+  fail "an installed header does not compile on its own"
+echo "ok: every installed header compiles on its own"

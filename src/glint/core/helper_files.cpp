@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <system_error>
 #include <vector>
@@ -11,8 +12,7 @@
 namespace glint {
 
 std::filesystem::path findHelperFile(std::string_view name, const char* override,
-                                     std::string_view buildPath, std::string_view installPath,
-                                     bool executable) {
+                                     const HelperPaths& paths, bool executable) {
   namespace fs = std::filesystem;
   if (const char* forced = std::getenv(override); forced != nullptr && *forced != 0) return forced;
   std::vector<fs::path> candidates;
@@ -22,8 +22,21 @@ std::filesystem::path findHelperFile(std::string_view name, const char* override
     candidates.push_back(self.parent_path() / name);
     candidates.push_back(self.parent_path().parent_path() / "libexec/glint" / name);
   }
-  if (!buildPath.empty()) candidates.emplace_back(buildPath);
-  if (!installPath.empty()) candidates.emplace_back(installPath);
+  if (!paths.build.empty() && !error) {
+    // The build tree's helper: for programs of that tree only (the helper lies at its top).
+    std::error_code canonicalError;
+    const fs::path buildTree =
+        fs::weakly_canonical(fs::path(paths.build).parent_path(), canonicalError);
+    const bool insideTree =
+        !canonicalError && !buildTree.empty() &&
+        std::mismatch(buildTree.begin(), buildTree.end(), self.begin(), self.end()).first ==
+            buildTree.end();
+    if (insideTree) candidates.emplace_back(paths.build);
+  }
+  if (!paths.install.empty()) candidates.emplace_back(paths.install);
+  if (!paths.package.empty() && paths.package != paths.install) {
+    candidates.emplace_back(paths.package);
+  }
   for (const fs::path& candidate : candidates) {
     if (fs::is_regular_file(candidate, error) &&
         ::access(candidate.c_str(), executable ? X_OK : R_OK) == 0)
@@ -46,11 +59,9 @@ constexpr const char* kIdentityFunctionName = GLINT_QUOTE_EXPANDED(GLINT_MODULE_
 
 }  // namespace
 
-void* loadHelperModule(std::string_view name, const char* override, std::string_view buildPath,
-                       std::string_view installPath, const char* identity, const char* entry,
-                       std::string& error) {
-  const std::filesystem::path path =
-      findHelperFile(name, override, buildPath, installPath, /*executable=*/false);
+void* loadHelperModule(std::string_view name, const char* override, const HelperPaths& paths,
+                       const char* identity, const char* entry, std::string& error) {
+  const std::filesystem::path path = findHelperFile(name, override, paths, /*executable=*/false);
   if (path.empty()) {
     error = fmt::format(
         "{} was not found beside this program, in ../libexec/glint from it, or where glint was "

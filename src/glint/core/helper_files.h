@@ -7,6 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include "glint/version.h"
+
 namespace glint {
 
 // The helper's path in this build tree and once installed, for the source file that finds it:
@@ -22,16 +24,35 @@ namespace glint {
 #else
 #define GLINT_HELPER_INSTALL_PATH_OR_EMPTY ""
 #endif
+#ifdef GLINT_HELPER_PACKAGE_PATH
+#define GLINT_HELPER_PACKAGE_PATH_OR_EMPTY GLINT_HELPER_PACKAGE_PATH
+#else
+#define GLINT_HELPER_PACKAGE_PATH_OR_EMPTY ""
+#endif
+// The three, for findHelperFile and loadHelperModule.
+#define GLINT_HELPER_PATHS                                                \
+  ::glint::HelperPaths {                                                  \
+    GLINT_HELPER_BUILD_PATH_OR_EMPTY, GLINT_HELPER_INSTALL_PATH_OR_EMPTY, \
+        GLINT_HELPER_PACKAGE_PATH_OR_EMPTY                                \
+  }
+
+// Where a helper was put by the build and by the installs (any may be empty).
+struct HelperPaths {
+  std::string_view build;    // the build tree's
+  std::string_view install;  // the configured install prefix's (cmake --install)
+  std::string_view package;  // the .deb's (/usr)
+};
 
 // The helper `name`: the path in environment variable `override` when it is set and not empty
 // (returned whether or not it exists, so that a wrong setting is reported as such); else the first
 // regular file that exists of: `name` beside the running program (a build tree, a program linked
 // with the library), ../libexec/glint/`name` from it (an installed tree, wherever it was moved),
-// `buildPath` and `installPath` (either may be empty). Empty when none is found. `executable`:
-// whether it must be executable (a program, not a module).
+// the build tree's — only for a program inside that build tree (its tests and tools: an installed
+// library never runs what a build folder happens to hold) —, the configured install prefix's and
+// the .deb's. Empty when none is found. `executable`: whether it must be executable (a program,
+// not a module).
 std::filesystem::path findHelperFile(std::string_view name, const char* override,
-                                     std::string_view buildPath, std::string_view installPath,
-                                     bool executable);
+                                     const HelperPaths& paths, bool executable);
 
 }  // namespace glint
 
@@ -55,8 +76,7 @@ namespace glint {
 // with dlopen (RTLD_NOW: every symbol resolved now, not at a first call in a server thread),
 // checked against `identity`, and `entry` looked up. Returns the entry point, or nullptr with the
 // reason in `error`, worded for the user. The module stays loaded until the process ends.
-void* loadHelperModule(std::string_view name, const char* override, std::string_view buildPath,
-                       std::string_view installPath, const char* identity, const char* entry,
-                       std::string& error);
+void* loadHelperModule(std::string_view name, const char* override, const HelperPaths& paths,
+                       const char* identity, const char* entry, std::string& error);
 
 }  // namespace glint

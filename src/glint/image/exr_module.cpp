@@ -6,9 +6,8 @@ namespace glint::exr_module {
 
 Codec* exrCodec(std::string& error) {
   static std::string loadError;
-  static void* const entry = loadHelperModule(
-      kModuleFile, "GLINT_EXR_MODULE", GLINT_HELPER_BUILD_PATH_OR_EMPTY,
-      GLINT_HELPER_INSTALL_PATH_OR_EMPTY, kModuleIdentity, kCodecFunction, loadError);
+  static void* const entry = loadHelperModule(kModuleFile, "GLINT_EXR_MODULE", GLINT_HELPER_PATHS,
+                                              kModuleIdentity, kCodecFunction, loadError);
   if (entry == nullptr) {
     error = loadError;
     return nullptr;

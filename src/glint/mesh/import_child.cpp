@@ -258,8 +258,7 @@ namespace {
 // program, ../libexec/glint from it, the build tree the library was built in, the installed
 // libexec folder.
 std::filesystem::path findMeshReader() {
-  return findHelperFile(kMeshReaderProgram, "GLINT_MESH_READER", GLINT_HELPER_BUILD_PATH_OR_EMPTY,
-                        GLINT_HELPER_INSTALL_PATH_OR_EMPTY, true);
+  return findHelperFile(kMeshReaderProgram, "GLINT_MESH_READER", GLINT_HELPER_PATHS, true);
 }
 
 // Found once per process.

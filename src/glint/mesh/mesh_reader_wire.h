@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "glint/mesh/mesh_file.h"
+#include "glint/version.h"
 
 namespace glint::wire {
 

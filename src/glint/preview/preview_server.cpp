@@ -106,8 +106,7 @@ bool isLoopbackHost(std::string_view host) {
 preview_http::StartFunction loadServerModule() {
   static std::string error;
   static void* const start =
-      loadHelperModule(preview_http::kModuleFile, "GLINT_PREVIEW_MODULE",
-                       GLINT_HELPER_BUILD_PATH_OR_EMPTY, GLINT_HELPER_INSTALL_PATH_OR_EMPTY,
+      loadHelperModule(preview_http::kModuleFile, "GLINT_PREVIEW_MODULE", GLINT_HELPER_PATHS,
                        preview_http::kModuleIdentity, preview_http::kStartFunction, error);
   if (start == nullptr) throw PreviewError("cannot start the preview: " + error);
   return reinterpret_cast<preview_http::StartFunction>(start);
