@@ -143,7 +143,10 @@ struct RenderJobResult {
 // cancel flag), warns about absurd pixel work, enforces the image limits, builds the scene, sets up
 // checkpoint/resume (fingerprint, mismatch, periodic saves), renders, and writes the image
 // atomically. Throws JobError for bad input (exit status 2) and failures (1); a stop through the
-// cancel flag is not an error but an Interrupted result.
+// cancel flag is not an error but an Interrupted result. An exception a callback of `events`
+// throws ends the job and comes out of runRenderJob as it was thrown (not as a JobError), with no
+// temporary file left behind. A missing OpenEXR module for an .exr output is a failure (1), found
+// before the scene is loaded.
 RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events = {});
 
 }  // namespace glint
