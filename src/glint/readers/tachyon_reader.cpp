@@ -251,6 +251,8 @@ class TachyonReader {
       } else if (o == "FOG_VMD") {
         fogVmd_ = true;
       } else if (o == "SHADOW_FILTER_ON") {
+      } else if (o == "AMBIENT_OCCLUSION") {
+        ambientOcclusion(t, option);
       } else if (o == "SHADOW_FILTER_OFF" || o == "TRANS_MAX_SURFACES") {
         if (o == "TRANS_MAX_SURFACES") in_.number(t, "surfaces");
         out_.warning(option.at, fmt::format("SHADER_MODE {} is ignored: glint filters shadows "
@@ -262,6 +264,57 @@ class TachyonReader {
         throw SyntaxError{};
       }
     }
+  }
+
+  // SHADER_MODE's AMBIENT_OCCLUSION AMBIENT_COLOR r g b RESCALE_DIRECT s SAMPLES n (what VMD
+  // writes with its ambient occlusion on). Tachyon adds to a surface's diffuse lighting
+  // AMBIENT_COLOR times the cosine-weighted open fraction of the hemisphere (n rays, shadow-style),
+  // and scales its lights by s: glint's render.ambient_occlusion on an ambient light of that colour
+  // and ka = the texture's DIFFUSE·COLOR, the texture's own AMBIENT·COLOR (which Tachyon does not
+  // occlude) becoming its emission, and the lights' colours × s. It changes the lights and the
+  // materials, so it must come before them, as VMD writes it. SAMPLES 0 is Tachyon's "off".
+  void ambientOcclusion(const Token& t, const Token& option) {
+    if (lightsRead_ || textures_.emittedAny()) {
+      out_.error(option.at,
+                 "SHADER_MODE AMBIENT_OCCLUSION must come before the scene's lights and textures "
+                 "(it rescales the lights and changes every texture's ambient term), as VMD "
+                 "writes it");
+      throw SyntaxError{};
+    }
+    AmbientOcclusion ao;
+    ao.at = option.at;
+    in_.keyword(t, "AMBIENT_COLOR");
+    ao.color = in_.color(t, "ambient occlusion color");
+    in_.keyword(t, "RESCALE_DIRECT");
+    ao.rescale = in_.number(t, "direct light scale");
+    if (!(ao.rescale.value >= 0) || !std::isfinite(ao.rescale.value)) {
+      out_.error(ao.rescale.at,
+                 fmt::format("RESCALE_DIRECT must be >= 0, got {}", ao.rescale.text));
+      throw SyntaxError{};
+    }
+    in_.keyword(t, "SAMPLES");
+    ao.samples = in_.number(t, "ambient occlusion samples");
+    if (!(ao.samples.value >= 0 && ao.samples.value <= 65536) ||
+        ao.samples.value != std::floor(ao.samples.value)) {
+      out_.error(
+          ao.samples.at,
+          fmt::format("SAMPLES must be a whole number from 0 to 65536, got {}", ao.samples.text));
+      throw SyntaxError{};
+    }
+    if (ao.samples.value == 0) return;
+    ambientOcclusion_ = ao;
+    textures_.setAmbientOcclusion(true);
+  }
+
+  // A light's COLOR, times RESCALE_DIRECT under ambient occlusion.
+  void emitLightColor(const Triple& color) {
+    if (!ambientOcclusion_ || ambientOcclusion_->rescale.value == 1) {
+      in_.emit("color", color);
+      return;
+    }
+    const double s = ambientOcclusion_->rescale.value;
+    const double scaled[3] = {color.n[0].value * s, color.n[1].value * s, color.n[2].value * s};
+    out_.computedTriple("color", scaled, color.n[0].at);
   }
 
   // BACKGROUND_GRADIENT SKY_SPHERE|SKY_ORTHO_PLANE UPDIR x y z TOPVAL t BOTTOMVAL b TOPCOLOR r g b
@@ -398,9 +451,10 @@ class TachyonReader {
       for (const Number& k : *attenuation) out_.scalar(k.text, k.at);
       out_.close();
     }
-    in_.emit("color", color);
+    emitLightColor(color);
     out_.close();
     out_.addEntity(EntityKind::LightEntity, map, type);
+    lightsRead_ = true;
   }
 
   void directionalLight(const Token& t) {
@@ -412,9 +466,10 @@ class TachyonReader {
     out_.openMap(t.at);
     const ValueId type = out_.entry("type", "directional", t.at);
     in_.emit("direction", direction);
-    in_.emit("color", color);
+    emitLightColor(color);
     out_.close();
     out_.addEntity(EntityKind::LightEntity, map, type);
+    lightsRead_ = true;
   }
 
   // --- the scene-wide entities, once everything is read ---------------------------------------
@@ -463,12 +518,20 @@ class TachyonReader {
     out_.openMap(camera_ ? c.raydepth.at : at);
     if (camera_) in_.emit("max_depth", c.raydepth);
     out_.entry("min_weight", "0", at);
+    if (ambientOcclusion_) {
+      out_.key("ambient_occlusion", ambientOcclusion_->at);
+      out_.openMap(ambientOcclusion_->at);
+      in_.emit("samples", ambientOcclusion_->samples);
+      out_.close();
+    }
     out_.close();
     out_.addEntity(EntityKind::RenderEntity, map);
 
-    // A texture's AMBIENT is its own ambient term: glint's ka under white ambient light 1.
+    // A texture's AMBIENT is its own ambient term: glint's ka under white ambient light 1. Under
+    // ambient occlusion the ambient light is AMBIENT_COLOR and ka the texture's diffuse colour.
     map = out_.nextId();
     out_.openMap(at);
+    if (ambientOcclusion_) in_.emit("color", ambientOcclusion_->color);
     out_.entry("intensity", "1", at);
     out_.close();
     out_.addEntity(EntityKind::AmbientEntity, map);
@@ -520,6 +583,13 @@ class TachyonReader {
   bool ended_ = false;
   bool transVmd_ = false;
   bool fogVmd_ = false;
+  bool lightsRead_ = false;
+  struct AmbientOcclusion {
+    TextPosition at;
+    Triple color;
+    Number rescale, samples;
+  };
+  std::optional<AmbientOcclusion> ambientOcclusion_;
   std::optional<Camera> camera_;
   std::optional<Triple> background_;
   TextPosition backgroundAt_;

@@ -12,6 +12,7 @@
 
 #include "glint/factories/scene_loader.h"
 #include "glint/scene/environment.h"
+#include "glint/scene/light.h"
 #include "glint/scene/texture.h"
 
 namespace glint {
@@ -233,6 +234,53 @@ TEST(TachyonReader, BackgroundGradientIsTachyonsSky) {
   const Color atOne = plane.along({0, 0, 1}, Color(), {-1, 5, 5});
   EXPECT_NEAR(atOne.r, 0.5, 1e-12);
   EXPECT_NEAR(atOne.g, 0.5, 1e-12);
+}
+
+// VMD's ambient occlusion (SHADER_MODE ... AMBIENT_OCCLUSION AMBIENT_COLOR RESCALE_DIRECT SAMPLES):
+// Tachyon adds AMBIENT_COLOR × DIFFUSE × COLOR × the cosine-weighted open fraction of the
+// hemisphere to a surface, keeps its AMBIENT × COLOR unoccluded and scales the lights: glint's
+// ambient occlusion on an ambient light of that colour with ka = DIFFUSE·COLOR, emission =
+// AMBIENT·COLOR, and the lights' colours scaled.
+TEST(TachyonReader, VmdAmbientOcclusionIsGlintsOnTheDiffuseColour) {
+  const std::string header =
+      "Begin_Scene\nResolution 8 8\nShader_Mode Full\n  Trans_VMD\n  Ambient_Occlusion\n"
+      "    Ambient_Color 0.8 0.7 0.6\n    Rescale_Direct 0.5\n    Samples 12\n"
+      "End_Shader_Mode\n";
+  const std::string body =
+      "Directional_Light Direction 0 0 1 Color 1 0.5 0.25\n"
+      "Light Center 0 5 0 Rad 0 Color 0.4 0.4 0.4\n"
+      "Texdef flat Ambient 0 Diffuse 0.5 Specular 0 Opacity 1 Color 1 0.5 0 TexFunc 0\n"
+      "Texdef glow Ambient 0.2 Diffuse 0.5 Specular 0 Opacity 1 Color 0 1 1 TexFunc 0\n"
+      "Sphere Center 0 0 5 Rad 1 flat\nSphere Center 2 0 5 Rad 1 glow\nEnd_Scene\n";
+  const ParseResult r = parseTachyon(header + body, "ao.dat");
+  ASSERT_FALSE(r.hasErrors()) << firstError(r);
+  const SceneParts parts = buildDescribedScene(r).parts;
+  ASSERT_TRUE(parts.render.ambientOcclusion.has_value());
+  EXPECT_EQ(parts.render.ambientOcclusion->samples, 12);
+  EXPECT_EQ(parts.ambient, Color(0.8, 0.7, 0.6));
+  ASSERT_EQ(parts.lights.size(), 2u);
+  EXPECT_EQ(std::get<DirectionalLight>(parts.lights[0]).intensity, Color(0.5, 0.25, 0.125));
+  EXPECT_EQ(std::get<PointLight>(parts.lights[1]).intensity, Color(0.2));
+  ASSERT_EQ(parts.primitives.size(), 2u);
+  const Material& flat = parts.materials[parts.primitives[0].materialIndex()];
+  EXPECT_EQ(flat.kd, Color(0.5, 0.25, 0));
+  EXPECT_EQ(flat.ka, flat.kd);
+  EXPECT_EQ(parts.primitives[0].emission(), Color());
+  const Material& glow = parts.materials[parts.primitives[1].materialIndex()];
+  EXPECT_EQ(glow.ka, glow.kd);
+  EXPECT_EQ(parts.primitives[1].emission(), Color(0, 0.2, 0.2));  // AMBIENT·COLOR, unoccluded
+  // It changes the lights and textures: after them it is an error; SAMPLES 0 is "off".
+  const std::string late = "Begin_Scene\nResolution 8 8\n" + body.substr(0, body.find("Texdef")) +
+                           "Shader_Mode Full\n  Ambient_Occlusion\n    Ambient_Color 1 1 1\n"
+                           "    Rescale_Direct 1\n    Samples 4\nEnd_Shader_Mode\nEnd_Scene\n";
+  EXPECT_THAT(firstError(parseTachyon(late, "late.dat")),
+              HasSubstr("late.dat:6:3: SHADER_MODE AMBIENT_OCCLUSION must come before the scene's "
+                        "lights and textures"));
+  std::string off = header + body;
+  off.replace(off.find("Samples 12"), 10, "Samples 0");
+  const ParseResult offResult = parseTachyon(off, "off.dat");
+  ASSERT_FALSE(offResult.hasErrors()) << firstError(offResult);
+  EXPECT_FALSE(buildDescribedScene(offResult).parts.render.ambientOcclusion.has_value());
 }
 
 TEST(TachyonReader, UnsupportedStatementsNameTheNearestSupportedOne) {

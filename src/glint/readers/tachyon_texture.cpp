@@ -256,12 +256,18 @@ std::string Textures::emitMaterial(const Texture& t, bool transVmd, const std::s
   const ValueId nameValue = out_.scalar(name, t.diffuse.at);
   const ValueId map = out_.nextId();
   out_.openMap(t.diffuse.at);
+  // Under ambient occlusion the occluded ambient light lights the diffuse colour, and the
+  // texture's own ambient term, which Tachyon never occludes, is its emission.
+  const bool glows = ambientOcclusion_ && t.ambient.value > 0;
   if (t.function == TexFunc::Constant) {
     out_.computedTriple("kd", kd, t.diffuse.at);
-    out_.computedTriple("ka", ka, t.ambient.at);
+    out_.computedTriple("ka", ambientOcclusion_ ? kd : ka, t.ambient.at);
+    if (glows) out_.computedTriple("emission", ka, t.ambient.at);
   } else {
     emitPattern("kd", t, t.diffuse.value * surface, t.diffuse.at);
-    emitPattern("ka", t, t.ambient.value * surface, t.ambient.at);
+    emitPattern("ka", t, (ambientOcclusion_ ? t.diffuse.value : t.ambient.value) * surface,
+                t.ambient.at);
+    if (glows) emitPattern("emission", t, t.ambient.value * surface, t.ambient.at);
   }
   if (phong != 0) {
     out_.computedTriple("ks", ks, t.phong.at);

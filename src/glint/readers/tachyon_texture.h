@@ -88,6 +88,11 @@ class Textures {
   std::string vertexColored(Texture texture, bool transVmd);
   // Tachyon's default texture (AMBIENT 0.1 DIFFUSE 0.9, white).
   Texture defaultTexture() const;
+  // Whether a material was emitted yet.
+  bool emittedAny() const { return !materialNames_.empty(); }
+  // SHADER_MODE's AMBIENT_OCCLUSION (tachyon_reader.cpp): every material after it has ka = its
+  // DIFFUSE·COLOR (lit by the occluded ambient light) and emission = its AMBIENT·COLOR.
+  void setAmbientOcclusion(bool on) { ambientOcclusion_ = on; }
 
  private:
   std::string emitMaterial(const Texture& texture, bool transVmd, const std::string& name);
@@ -101,6 +106,7 @@ class Textures {
   void requireRange(const Number& n, double lo, double hi, std::string_view what);
 
   std::set<std::string> materialNames_;  // every material emitted
+  bool ambientOcclusion_ = false;
   // Per TEXDEF name defined again, the suffix to try next (name_2, name_3...): names are never
   // freed, so every smaller suffix is taken and a redefinition costs no search from 2.
   std::map<std::string, int> nextSuffix_;
