@@ -283,6 +283,28 @@ TEST(TachyonReader, VmdAmbientOcclusionIsGlintsOnTheDiffuseColour) {
   EXPECT_FALSE(buildDescribedScene(offResult).parts.render.ambientOcclusion.has_value());
 }
 
+// Tachyon finds a texture name's first definition: a TEXDEF of a name already defined changes
+// nothing (a warning says so).
+TEST(TachyonReader, ATexdefOfADefinedNameKeepsTheFirst) {
+  const ParseResult r = parseTachyon(
+      "Begin_Scene\nResolution 8 8\n"
+      "Texdef a Ambient 0 Diffuse 1 Specular 0 Opacity 1 Color 1 0 0 TexFunc 0\n"
+      "Sphere Center -1.2 0 5 Rad 1 a\n"
+      "Texdef a Ambient 0 Diffuse 1 Specular 0 Opacity 1 Color 0 0 1 TexFunc 0\n"
+      "Sphere Center 1.2 0 5 Rad 1 a\nEnd_Scene\n",
+      "redef.dat");
+  ASSERT_FALSE(r.hasErrors()) << firstError(r);
+  const LoadedScene loaded = buildDescribedScene(r);
+  ASSERT_EQ(loaded.parts.primitives.size(), 2u);
+  for (const Primitive& sphere : loaded.parts.primitives) {
+    EXPECT_EQ(loaded.parts.materials[sphere.materialIndex()].kd, Color(1, 0, 0));
+  }
+  ASSERT_EQ(r.diagnostics.size(), 1u);
+  EXPECT_EQ(r.diagnostics[0].format(),
+            "redef.dat:5:8: warning: TEXDEF 'a' is already defined (line 3); as Tachyon does, "
+            "the first definition is kept");
+}
+
 TEST(TachyonReader, UnsupportedStatementsNameTheNearestSupportedOne) {
   const auto error = [](const std::string& body) {
     return firstError(

@@ -338,7 +338,14 @@ void Textures::emitPattern(std::string_view key, const Texture& t, double factor
 
 void Textures::define(const std::string& name, const Texture& texture, const TextPosition& at,
                       bool transVmd) {
-  (void)at;
+  // Tachyon looks a name up in the order the textures were defined: the first definition wins.
+  if (const auto it = definedAt_.find(name); it != definedAt_.end()) {
+    out_.warning(at, fmt::format("TEXDEF {} is already defined (line {}); as Tachyon does, the "
+                                 "first definition is kept",
+                                 quoteForMessage(name), it->second.line));
+    return;
+  }
+  definedAt_.emplace(name, at);
   std::string material = name;
   if (materialNames_.count(material) > 0) {
     int& k = nextSuffix_.try_emplace(name, 2).first->second;

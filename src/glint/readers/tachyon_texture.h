@@ -76,7 +76,8 @@ class Textures {
   Textures(Input& in, SceneEmitter& out) : in_(in), out_(out) {}
   // Reads a texture body after TEXTURE or TEXDEF name (`vertexColors`: VCST instead of COLOR).
   Texture body(const Token& statement, bool vertexColors);
-  // TEXDEF: the material `name` (a later TEXDEF of the same name replaces it for what follows).
+  // TEXDEF: the material `name` (a later TEXDEF of the same name is ignored with a warning, as
+  // Tachyon keeps the first).
   void define(const std::string& name, const Texture& texture, const TextPosition& at,
               bool transVmd);
   void alias(const std::string& alias, const Token& original);
@@ -100,9 +101,10 @@ class Textures {
   void emitPattern(std::string_view key, const Texture& t, double factor, const TextPosition& at);
   Input& in_;
   SceneEmitter& out_;
-  std::map<std::string, std::string> named_;     // TEXDEF and TEXALIAS names → material names
-  std::map<std::string, std::string> byValues_;  // a material's values → its name
-  std::map<std::string, Texture> definitions_;   // TEXDEF name → its texture (vertex colours)
+  std::map<std::string, std::string> named_;       // TEXDEF and TEXALIAS names → material names
+  std::map<std::string, std::string> byValues_;    // a material's values → its name
+  std::map<std::string, Texture> definitions_;     // TEXDEF name → its texture (vertex colours)
+  std::map<std::string, TextPosition> definedAt_;  // TEXDEF name → where it was defined
   void requireRange(const Number& n, double lo, double hi, std::string_view what);
 
   std::set<std::string> materialNames_;  // every material emitted
