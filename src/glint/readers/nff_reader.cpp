@@ -401,6 +401,15 @@ class NffReader {
         if (patch) vertices[i].normal[k] = tree.addScalar(t[k + 3].text, t[k + 3].at);
       }
       points[i] = Point3{v[0], v[1], v[2]};
+      // Checked here, not only when the mesh is built: past it the polygon's normal overflows and
+      // the polygon would be left out as having no area.
+      if (!(std::abs(v[0]) <= kMaxCoordinate && std::abs(v[1]) <= kMaxCoordinate &&
+            std::abs(v[2]) <= kMaxCoordinate)) {
+        out_.error(t[0].at, fmt::format("{}: a vertex must lie within ±{:g} of the origin, got "
+                                        "[{}, {}, {}] (glint's coordinates stay below it)",
+                                        p.text, kMaxCoordinate, t[0].text, t[1].text, t[2].text));
+        throw SyntaxError{};
+      }
     }
     const std::string m = material(false);
     bool fanned = false;

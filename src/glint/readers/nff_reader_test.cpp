@@ -174,6 +174,11 @@ TEST(NffReader, PolygonsThatCrossThemselvesOrBendAreWarnedAbout) {
   for (int i = 0; i < 4097; ++i) big += "0 0 0\n";
   EXPECT_EQ(firstError(parseNff(view + big, "a.nff")),
             "a.nff:4:3: p: the number of vertices must be a whole number from 3 to 4096, got 4097");
+  // A vertex past glint's coordinates is an error there, not a polygon left out as collinear (its
+  // normal overflowed).
+  EXPECT_EQ(firstError(parseNff(view + "p 3\n1e308 0 0\n-1e308 0 0\n0 0 1e308\n", "a.nff")),
+            "a.nff:5:1: p: a vertex must lie within ±1e+100 of the origin, got [1e308, 0, 0] "
+            "(glint's coordinates stay below it)");
 }
 
 // Text that is no text: a NUL byte is refused at its place (it read as a blank); a UTF-8
