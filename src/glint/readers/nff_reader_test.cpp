@@ -174,6 +174,13 @@ TEST(NffReader, PolygonsThatCrossThemselvesOrBendAreWarnedAbout) {
   for (int i = 0; i < 4097; ++i) big += "0 0 0\n";
   EXPECT_EQ(firstError(parseNff(view + big, "a.nff")),
             "a.nff:4:3: p: the number of vertices must be a whole number from 3 to 4096, got 4097");
+  // A number below the smallest double is 0 (as in YAML scenes), one above the largest an error.
+  {
+    const ParseResult tiny = parseNff(view + "s 0 0 0 1\ns 0 1e-400 0 1\n", "a.nff");
+    EXPECT_FALSE(tiny.hasErrors()) << firstError(tiny);
+    EXPECT_EQ(firstError(parseNff(view + "s 0 1e400 0 1\n", "a.nff")),
+              "a.nff:4:5: s: expected a number (center y), got '1e400'");
+  }
   // A vertex past glint's coordinates is an error there, not a polygon left out as collinear (its
   // normal overflowed).
   EXPECT_EQ(firstError(parseNff(view + "p 3\n1e308 0 0\n-1e308 0 0\n0 0 1e308\n", "a.nff")),

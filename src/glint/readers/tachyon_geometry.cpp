@@ -132,8 +132,9 @@ void Geometry::vertexArray(const Token& t) {
   in_.keyword(t, "NUMVERTS");
   const Number count = in_.number(t, "vertex count");
   if (!(count.value >= 0 && count.value == std::floor(count.value) && count.value < 1e9)) {
-    out_.error(count.at,
-               fmt::format("VERTEXARRAY: NUMVERTS must be a whole number, got {}", count.text));
+    out_.error(
+        count.at,
+        fmt::format("VERTEXARRAY: NUMVERTS must be a whole number below 1e9, got {}", count.text));
     throw SyntaxError{};
   }
   const auto n = static_cast<std::size_t>(count.value);
@@ -174,7 +175,8 @@ void Geometry::vertexArray(const Token& t) {
       const bool strip = b == "TRISTRIP";
       const Number m = in_.number(t, strip ? "strip length" : "triangle count");
       if (!(m.value >= 0 && m.value == std::floor(m.value) && m.value < 1e9)) {
-        out_.error(m.at, fmt::format("{}: expected a whole number, got {}", block.text, m.text));
+        out_.error(
+            m.at, fmt::format("{}: expected a whole number below 1e9, got {}", block.text, m.text));
         throw SyntaxError{};
       }
       const auto items = static_cast<std::size_t>(m.value) * (strip ? 1 : 3);

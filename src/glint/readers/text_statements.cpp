@@ -3,6 +3,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <optional>
 #include <system_error>
@@ -93,7 +94,15 @@ std::optional<double> parseNumber(std::string_view text) {
   const char* end = text.data() + text.size();
   const auto [ptr, ec] = std::from_chars(text.data(), end, value);
   if (ptr != end) return std::nullopt;
-  if (ec != std::errc() || !std::isfinite(value)) return std::nullopt;
+  if (ec == std::errc::result_out_of_range) {
+    // from_chars leaves the value unset; strtod rounds as YAML's numbers do (parameter_dictionary):
+    // an underflow ("1e-400") is 0 or a subnormal, an overflow infinite and refused.
+    const std::string copy(text);
+    value = std::strtod(copy.c_str(), nullptr);
+  } else if (ec != std::errc()) {
+    return std::nullopt;
+  }
+  if (!std::isfinite(value)) return std::nullopt;
   return value;
 }
 
