@@ -53,17 +53,26 @@ struct SyntaxError {};
 class NffReader {
  public:
   NffReader(std::string_view text, SceneEmitter& out, const std::atomic<bool>* cancel)
-      : tokens_(text), out_(out), cancel_(cancel) {}
+      : text_(text), tokens_(text), out_(out), cancel_(cancel) {}
 
   void read() {
     std::size_t statements = 0;
+    std::optional<Token> last;
     while (const std::optional<Token> t = tokens_.next()) {
       if (++statements % kStatementsPerPoll == 0) throwIfCancelled(cancel_);
+      last = t;
       try {
         statement(*t);
       } catch (const SyntaxError&) {
         skipToNextStatement();
       }
+    }
+    // NFF has no end marker: a file cut inside its last number ("0.0555556" as "0.05") reads as
+    // a whole file. The generators end every line with a line break.
+    if (last && !text_.empty() && text_.back() != '\n' && text_.back() != '\r') {
+      out_.warning(last->at,
+                   "the file does not end with a line break: if it was cut short, the "
+                   "last statement's numbers may be incomplete");
     }
     if (!viewRead_ && !sawView_) {
       out_.error({0, 1, 1},
@@ -590,6 +599,7 @@ class NffReader {
     return out;
   }
 
+  std::string_view text_;
   Tokenizer tokens_;
   SceneEmitter& out_;
   const std::atomic<bool>* cancel_;

@@ -174,6 +174,13 @@ TEST(NffReader, PolygonsThatCrossThemselvesOrBendAreWarnedAbout) {
   for (int i = 0; i < 4097; ++i) big += "0 0 0\n";
   EXPECT_EQ(firstError(parseNff(view + big, "a.nff")),
             "a.nff:4:3: p: the number of vertices must be a whole number from 3 to 4096, got 4097");
+  // A file cut inside its last number reads as a whole one; without its final line break it is
+  // suspect, and a warning says so.
+  EXPECT_EQ(warningsOf(parseNff(view + "s 0 0 0 0.05", "a.nff")),
+            std::vector<std::string>{"a.nff:4:1: warning: the file does not end with a line "
+                                     "break: if it was cut short, the last statement's numbers "
+                                     "may be incomplete"});
+  EXPECT_TRUE(warningsOf(parseNff(view + "s 0 0 0 0.05\r\n", "a.nff")).empty());
   // A number below the smallest double is 0 (as in YAML scenes), one above the largest an error.
   {
     const ParseResult tiny = parseNff(view + "s 0 0 0 1\ns 0 1e-400 0 1\n", "a.nff");
