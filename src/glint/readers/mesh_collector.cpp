@@ -1,5 +1,7 @@
 #include "glint/readers/mesh_collector.h"
 
+#include <fmt/format.h>
+
 #include <string>
 #include <utility>
 
@@ -51,6 +53,17 @@ void MeshCollector::add(ValueTree& tree, const std::string& material, const Coll
 void MeshCollector::emit(SceneEmitter& out) {
   ValueTree& tree = out.tree();
   for (Group& g : groups_) {
+    // Vertices written alike are one vertex: triangles on fewer than three distinct points have
+    // no area anywhere. Said here, in the file's terms, rather than as a mesh of too few
+    // positions.
+    if (g.vertices.size() < 3) {
+      out.warning(g.first, fmt::format("{} degenerate triangle{} (no area: {} distinct vertices) "
+                                       "left out",
+                                       g.triangleAt.size(), g.triangleAt.size() == 1 ? "" : "s",
+                                       g.vertices.size()));
+      g = Group{};
+      continue;
+    }
     const ValueId map = out.nextId();
     out.openMap(g.first);
     const ValueId type = out.entry("type", "mesh", g.first);

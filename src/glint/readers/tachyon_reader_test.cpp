@@ -305,6 +305,21 @@ TEST(TachyonReader, ATexdefOfADefinedNameKeepsTheFirst) {
             "the first definition is kept");
 }
 
+// Triangles of one texture on fewer than three distinct points (vertices written alike are one)
+// are left out with a warning in the file's terms, not refused as a mesh of too few positions.
+TEST(TachyonReader, TrianglesOnTwoPointsAreLeftOutWithAWarning) {
+  const ParseResult r = parseTachyon(
+      "BEGIN_SCENE\nRESOLUTION 8 8\n"
+      "TEXDEF t AMBIENT 0 DIFFUSE 1 SPECULAR 0 OPACITY 1 COLOR 1 0 0 TEXFUNC 0\n"
+      "TRI V0 1 0 0 V1 1 0 0 V2 2 0 0 t\nEND_SCENE\n",
+      "tri.dat");
+  ASSERT_FALSE(r.hasErrors()) << firstError(r);
+  ASSERT_EQ(r.diagnostics.size(), 1u);
+  EXPECT_EQ(r.diagnostics[0].format(),
+            "tri.dat:4:1: warning: 1 degenerate triangle (no area: 2 distinct vertices) left out");
+  EXPECT_TRUE(buildDescribedScene(r).parts.meshes.empty());
+}
+
 TEST(TachyonReader, UnsupportedStatementsNameTheNearestSupportedOne) {
   const auto error = [](const std::string& body) {
     return firstError(
