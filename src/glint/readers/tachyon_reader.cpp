@@ -78,16 +78,20 @@ class TachyonReader {
       return;
     }
     std::size_t statements = 0;
+    bool failed = false;
     while (!ended_) {
       const std::optional<Token> t = in_.tokens().next();
       if (!t) {
-        out_.error(in_.tokens().end(), "the file ends without END_SCENE");
+        // After a statement's error the END_SCENE may have been read as one of its values (a
+        // texture name, say): the error already said what is wrong there.
+        if (!failed) out_.error(in_.tokens().end(), "the file ends without END_SCENE");
         break;
       }
       if (++statements % kStatementsPerPoll == 0) throwIfCancelled(cancel_);
       try {
         statement(*t);
       } catch (const SyntaxError&) {
+        failed = true;
         skipToNextStatement();
       }
     }

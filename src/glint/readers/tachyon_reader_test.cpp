@@ -391,6 +391,14 @@ TEST(TachyonReader, UnsupportedStatementsNameTheNearestSupportedOne) {
             "BEGIN_SCENE and RESOLUTION");
   EXPECT_THAT(firstError(parseTachyon("BEGIN_SCENE RESOLUTION 8 8 SPHERE", "a.dat")),
               HasSubstr("the file ends inside SPHERE"));
+  // A statement that read END_SCENE as one of its values has the one error, not also "the file
+  // ends without END_SCENE".
+  const ParseResult noTexture =
+      parseTachyon("BEGIN_SCENE\nRESOLUTION 8 8\nSPHERE CENTER 0 0 0 RAD 1\nEND_SCENE\n", "a.dat");
+  ASSERT_EQ(noTexture.diagnostics.size(), 1u);
+  EXPECT_EQ(noTexture.diagnostics[0].format(),
+            "a.dat:4:1: SPHERE: undefined texture 'END_SCENE' (a TEXDEF name, or TEXTURE and its "
+            "definition)");
 }
 
 }  // namespace
