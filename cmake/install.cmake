@@ -2,12 +2,13 @@
 #   bin/glint                                the command            (component runtime)
 #   libexec/glint/glint-mesh-reader          reads mesh files for glint and the library (runtime)
 #   libexec/glint/glint-*.so                 modules loaded on demand: the preview's HTTP server,
-#                                            OpenEXR, the MPI transport (runtime)
+#                                            OpenEXR (runtime), the MPI transport (component mpi)
 #   lib/libglint.a, include/glint/           the library, headers   (component dev)
 #   lib/cmake/glint/                         find_package(glint CONFIG) -> glint::glint (dev)
-# `cpack --config build/CPackConfig.cmake` makes two .debs: glint (the command; its Depends from
-# dpkg-shlibdeps) and libglint-dev (library, headers, package; Depends on the -dev packages that
-# glintConfig.cmake finds, and on glint for the same version).
+# `cpack --config build/CPackConfig.cmake` makes the .debs: glint (the command; its Depends from
+# dpkg-shlibdeps), glint-mpi (the MPI module, with MPI builds) and libglint-dev (library, headers,
+# package; Depends on the -dev packages that glintConfig.cmake finds, and on glint for the same
+# version).
 include(CMakePackageConfigHelpers)
 
 install(TARGETS glint_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
@@ -15,9 +16,10 @@ install(TARGETS glint_mesh_reader RUNTIME DESTINATION ${CMAKE_INSTALL_LIBEXECDIR
         COMPONENT runtime)
 install(TARGETS glint_preview_http glint_exr LIBRARY DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/glint
         COMPONENT runtime)
+# Its own component (and .deb, glint-mpi): OpenMPI is large, and only `mpirun glint` loads it.
 if(TARGET glint_mpi)
   install(TARGETS glint_mpi LIBRARY DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/glint
-          COMPONENT runtime)
+          COMPONENT mpi)
 endif()
 install(TARGETS glint EXPORT glintTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT dev)
@@ -46,7 +48,11 @@ set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGING_INSTALL_PREFIX ${GLINT_PACKAGE_PREFIX})
 set(CPACK_GENERATOR DEB)
 set(CPACK_DEB_COMPONENT_INSTALL ON)
-set(CPACK_COMPONENTS_ALL runtime dev)
+if(TARGET glint_mpi)
+  set(CPACK_COMPONENTS_ALL runtime mpi dev)
+else()
+  set(CPACK_COMPONENTS_ALL runtime dev)
+endif()
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION graphics)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME glint)
@@ -55,6 +61,14 @@ set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_RUNTIME_DESCRIPTION "fast, exact Whitted ray tracer for YAML scene files
 Renders scenes of shapes, triangle meshes (OBJ, PLY, STL, glTF), lights and materials to PNG, PPM
 or OpenEXR on every core, with a live preview in the browser.")
+# One frame across MPI ranks (docs/distributed.md): the module alone, its Depends from
+# dpkg-shlibdeps (OpenMPI), offered by glint rather than required.
+set(CPACK_DEBIAN_MPI_PACKAGE_NAME glint-mpi)
+set(CPACK_DEBIAN_MPI_PACKAGE_SHLIBDEPS ON)
+set(CPACK_DEBIAN_MPI_PACKAGE_DEPENDS "glint (= ${PROJECT_VERSION})")
+set(CPACK_DEBIAN_MPI_DESCRIPTION "glint ray tracer: one frame across OpenMPI ranks
+The module glint loads when started by mpirun: tiles rendered on every rank, one image.")
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_SUGGESTS "glint-mpi")
 set(CPACK_DEBIAN_DEV_PACKAGE_NAME libglint-dev)
 set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 set(CPACK_DEBIAN_DEV_DESCRIPTION "glint ray tracer: static library, headers and CMake package

@@ -42,10 +42,18 @@ for module in glint-preview-http.so glint-exr.so; do
   grep -q "\./usr/libexec/glint/$module\$" <<<"$runtime_files" ||
     fail "no /usr/libexec/glint/$module in the package"
 done
+# The MPI module is a package of its own: glint does not pull OpenMPI in.
+! grep -q "libopenmpi" <<<"$depends" || fail "glint's Depends name OpenMPI (the MPI module's)"
 if [[ -f "$build/glint-mpi.so" ]]; then
-  grep -q '\./usr/libexec/glint/glint-mpi\.so$' <<<"$runtime_files" ||
-    fail "no /usr/libexec/glint/glint-mpi.so in the package"
-  grep -q "libopenmpi" <<<"$depends" || fail "glint's Depends lack libopenmpi (its MPI module)"
+  mpi="$(find "$work/packages" -maxdepth 1 -name 'glint-mpi_*.deb')"
+  [[ -f "$mpi" ]] || fail "no glint-mpi_*.deb, got: $(ls "$work/packages")"
+  dpkg-deb -c "$mpi" | grep -q '\./usr/libexec/glint/glint-mpi\.so$' ||
+    fail "no /usr/libexec/glint/glint-mpi.so in glint-mpi"
+  mpi_depends="$(dpkg-deb -f "$mpi" Depends)"
+  echo "glint-mpi Depends: $mpi_depends"
+  grep -q "libopenmpi" <<<"$mpi_depends" || fail "glint-mpi's Depends lack libopenmpi"
+  grep -q "glint (= " <<<"$mpi_depends" || fail "glint-mpi does not depend on glint"
+  grep -q "glint-mpi" <<<"$(dpkg-deb -f "$runtime" Suggests)" || fail "glint does not suggest glint-mpi"
 fi
 grep -q 'usr/include/glint/glint.h$' <<<"$dev_files" || fail "no glint.h in libglint-dev"
 grep -q 'cmake/glint/glintConfig.cmake$' <<<"$dev_files" || fail "no CMake package in libglint-dev"
