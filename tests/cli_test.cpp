@@ -846,6 +846,12 @@ TEST_F(Cli, TexturesCountAgainstTheMemoryBudgetBeforeTheyAreDecoded) {
   EXPECT_TRUE(contains(r.err, "HDR 1024×512 image needs about 8.0 MiB")) << r.err;
   EXPECT_TRUE(contains(r.err, "more than the memory limit of 4.0 MiB")) << r.err;
   EXPECT_TRUE(filesIn(work_).empty());
+  // check reports the same refusals as render, with the same limit.
+  const RunResult checked = run({"check", scene, "--max-memory", "4M"});
+  EXPECT_EQ(checked.status, 2);
+  EXPECT_TRUE(contains(checked.err, "cannot load texture file 'textures/sky.hdr'")) << checked.err;
+  EXPECT_TRUE(contains(checked.err, "more than the memory limit of 4.0 MiB")) << checked.err;
+  EXPECT_EQ(run({"check", scene, "--max-memory", "64M"}).status, 0);
 }
 
 TEST_F(Cli, MaxMemoryWithABadSizeIsAnArgumentError) {

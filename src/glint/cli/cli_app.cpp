@@ -314,9 +314,10 @@ int reportJobError(const JobError& error, const std::string& sceneFile) {
 
 // --- commands -------------------------------------------------------------------------------
 
-int runCheck(const std::string& file) {
+int runCheck(const std::string& file, const std::optional<std::string>& maxMemory) {
   CheckOptions options;
   options.warnings = printDiagnostics;
+  if (maxMemory) options.memoryBudget = parseMemorySize(*maxMemory);
   SceneFacts scene;
   try {
     scene = checkScene(file, options);
@@ -585,7 +586,8 @@ int parseFailure(const CLI::ParseError& error, const CLI::App& app, int argc, ch
 
 int runCommandLine(int argc, char** argv) {
   CLI::App app{
-      "glint: a Whitted ray tracer. Renders YAML scene files to PNG, PPM or OpenEXR images.",
+      "glint: a ray tracer (Whitted's model, or path tracing). Renders scene files — YAML, NFF, "
+      "Tachyon .dat, mesh files — to PNG, PPM or OpenEXR images.",
       "glint"};
   app.set_version_flag("--version", std::string("glint ") + GLINT_VERSION,
                        "Print the version and exit");
@@ -659,12 +661,19 @@ int runCommandLine(int argc, char** argv) {
   render->add_flag("--stats", args.stats, "More statistics at the end");
   const PreviewOptions previewOptions(*render);
 
-  std::string checkFile;
+  std::string checkFile, checkMaxMemory;
   CLI::App* check =
       app.add_subcommand("check", "Parse and build a scene, print a summary; writes nothing");
   check->add_option("SCENE", checkFile, "Scene file (YAML, JSON, .nff, .dat, or a mesh file)")
       ->required()
       ->type_name("FILE");
+  // The memory estimate's refusals are among the errors check reports as render does.
+  CLI::Option* checkMaxMemoryOption =
+      check
+          ->add_option("--max-memory", checkMaxMemory,
+                       "Memory the scene may need, as for render (default: half the physical "
+                       "memory)")
+          ->type_name("SIZE");
 
   std::string convertFile, convertOutput;
   CLI::App* convert = app.add_subcommand(
@@ -736,7 +745,7 @@ int runCommandLine(int argc, char** argv) {
     throw CliError(kExitBadInput, error.what());
   }
 
-  if (check->parsed()) return runCheck(checkFile);
+  if (check->parsed()) return runCheck(checkFile, given(checkMaxMemoryOption, checkMaxMemory));
   SignalGuard signals;
   if (convert->parsed()) return runConvert(convertFile, convertOutput, signals);
   return runRender(args, signals);
