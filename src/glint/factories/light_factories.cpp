@@ -154,6 +154,18 @@ std::optional<Light> readArea(ParameterDictionary& p, BuildContext& ctx) {
     }
   }
   const ObjectFactory* shape = areaShape(p);
+  // The keys of its shape are offered in messages (a disk's but inner_radius: a disk light is a
+  // whole disk); the other shapes' are accepted only to be refused by name below.
+  for (const std::string_view key : geometryKeys) {
+    const bool offered =
+        shape != nullptr && key != "inner_radius" &&
+        std::find(shape->keys.begin(), shape->keys.end(), key) != shape->keys.end();
+    if (offered) {
+      p.declare({key});
+    } else {
+      p.declareHidden(key);
+    }
+  }
   if (shape == nullptr) {
     p.markUsed(geometryKeys);  // without a shape its geometry keys cannot be checked
     return std::nullopt;
@@ -164,10 +176,14 @@ std::optional<Light> readArea(ParameterDictionary& p, BuildContext& ctx) {
         std::find(shape->keys.begin(), shape->keys.end(), key) != shape->keys.end()) {
       continue;
     }
-    p.error(p.keyPlace(key),
-            fmt::format("'{}' is a key of a {} area light, not of a {}; a {} takes {}", key,
-                        fmt::join(owners, " or "), shape->type, shape->type,
-                        fmt::join(shape->keys, ", ")));
+    std::vector<std::string_view> takes;
+    for (const std::string_view k : shape->keys) {
+      if (k != "inner_radius") takes.push_back(k);
+    }
+    p.error(
+        p.keyPlace(key),
+        fmt::format("'{}' is a key of a {} area light, not of a {}; a {} takes {}", key,
+                    fmt::join(owners, " or "), shape->type, shape->type, fmt::join(takes, ", ")));
     p.markUsed({key});
   }
   p.setOwner(std::string(shape->type) + " area light");
@@ -210,16 +226,9 @@ const std::vector<LightFactory>& lightFactories() {
          {"position", "direction", "color", "intensity", "attenuation", "exponent", "falloff_start",
           "falloff_end"},
          readSpot},
+        // The geometry keys of its shape are declared by readArea, once the shape is known.
         {"area", {"shape", "color", "intensity", "attenuation", "samples"}, readArea},
     };
-    // Every geometry key of every area shape is an area light's key, so that a key of another
-    // shape gets its own message rather than a plain "unknown key".
-    for (const ObjectFactory* f : areaShapeFactories()) {
-      for (const std::string_view key : f->keys) {
-        std::vector<std::string_view>& keys = table.back().keys;
-        if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
-      }
-    }
     return table;
   }();
   return factories;

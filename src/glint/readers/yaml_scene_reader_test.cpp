@@ -515,8 +515,15 @@ TEST(SceneParser, AreaLightKeyErrors) {
   // A misspelt shape is one error: the unknown key, with the suggestion.
   expectLightError("{type: area, shap: disk, center: [0, 1, 0], radius: 1}", "shap",
                    "unknown key 'shap' in area light; expected one of: shape, color, intensity, "
-                   "attenuation, samples, corner, edges, center, normal, radius, inner_radius "
-                   "(did you mean 'shape'?)");
+                   "attenuation, samples (did you mean 'shape'?)");
+  // With its shape known, a misspelt key is offered that shape's keys only (a disk light's
+  // without inner_radius: it is a whole disk).
+  expectLightError(
+      "{type: area, shape: disk, center: [0, 1, 0], normal: [0, -1, 0], radius: 1, "
+      "radus: 2}",
+      "radus",
+      "unknown key 'radus' in area light; expected one of: shape, color, intensity, "
+      "attenuation, samples, center, normal, radius (did you mean 'radius'?)");
   expectLightError("{type: area, shape: square, corner: [0, 1, 0]}", "square",
                    "unknown area light shape 'square'; expected one of: rectangle, disk, sphere");
   expectLightError("{type: area, shape: spere, center: [0, 1, 0], radius: 1}", "spere",
