@@ -28,8 +28,8 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/glint/ DESTINATION ${CMAKE_INSTALL_I
         COMPONENT dev FILES_MATCHING PATTERN "*.h"
         PATTERN "*_test_support.h" EXCLUDE PATTERN "cli" EXCLUDE
         PATTERN "cluster" EXCLUDE)  # built only with MPI, into the command alone
-install(FILES ${PROJECT_BINARY_DIR}/include/glint/version.h
-        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/glint COMPONENT dev)
+install(FILES ${PROJECT_BINARY_DIR}/include/glint/core/version.h
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/glint/core COMPONENT dev)
 
 set(GLINT_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/glint)
 install(EXPORT glintTargets NAMESPACE glint:: DESTINATION ${GLINT_CMAKE_DIR} COMPONENT dev)

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "glint/version.h"
+#include "glint/core/version.h"
 
 namespace glint {
 

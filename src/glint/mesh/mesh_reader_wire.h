@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "glint/mesh/mesh_file.h"
-#include "glint/version.h"
+#include "glint/core/version.h"
 
 namespace glint::wire {
 
