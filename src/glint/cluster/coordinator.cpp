@@ -266,7 +266,7 @@ void Coordinator::render(const Scene& scene, const RenderOptions& options, Film&
   {
     const CheckpointSettings settings =
         checkpointSettingsFor(scene, film.region(), options.tileSize);
-    const std::string bytes = readSceneFileAgain(sceneFile_);
+    const std::string bytes = fingerprintedSceneText(sceneFile_, scene);
     mine = identityOf(sceneFile_, bytes, scene, settings, threads_, session_.host());
   }
   if (!awaitHellos(mine, options.cancel)) {

@@ -70,7 +70,9 @@ std::optional<std::string> identityDifference(const RankIdentity& reference,
     return fmt::format("its render has {} {}, rank 0's has {}", difference->what, difference->first,
                        difference->second);
   if (other.sceneBytes != reference.sceneBytes || other.sceneHash != reference.sceneHash)
-    return fmt::format("its scene file '{}' ({}) differs from rank 0's '{}' ({})", other.sceneFile,
+    return fmt::format("its scene file '{}' or a file it includes ({}) differs from rank 0's '{}' "
+                       "({})",
+                       other.sceneFile,
                        fileFacts(other.sceneBytes, other.sceneHash), reference.sceneFile,
                        fileFacts(reference.sceneBytes, reference.sceneHash));
   if (other.meshCount != reference.meshCount || other.meshHash != reference.meshHash)

@@ -47,7 +47,7 @@ void loadRender(const RenderJobSpec& spec, int threads, const std::string& host,
     enforceImageLimits(allocated, spec.requestText, spec.memoryBudget);
     scene.parts.isa = spec.isa;  // --isa on every rank (a rank whose CPU lacks it reports so)
     loaded.scene.emplace(freezeScene(std::move(scene.parts), spec.scene.string()));
-    const std::string bytes = readSceneFileAgain(spec.scene);
+    const std::string bytes = fingerprintedSceneText(spec.scene, *loaded.scene);
     loaded.identity = identityOf(spec.scene, bytes, *loaded.scene,
                                  checkpointSettingsFor(*loaded.scene, loaded.region, spec.tileSize),
                                  threads, host);

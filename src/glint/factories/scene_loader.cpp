@@ -57,6 +57,9 @@ LoadedScene build(const ParseResult& parsed, const LoadOptions& options) {
   std::stable_sort(warnings.begin(), warnings.end(), std::cref(before));
   if (!errors.empty()) throw SceneError(std::move(errors));
   const SourceFile& scene = *parsed.description.files.at(0);
+  for (std::size_t i = 1; i < parsed.description.files.size(); ++i) {
+    built.parts.includedFiles.emplace_back(parsed.description.files[i]->name);
+  }
   return LoadedScene{std::move(built.parts), std::move(warnings), scene.bytes};
 }
 

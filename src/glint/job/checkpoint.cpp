@@ -563,8 +563,8 @@ std::optional<std::string> checkpointMismatch(const Checkpoint& checkpoint,
                        difference->first, difference->second);
   if (checkpoint.fingerprint != fingerprint)
     return std::string(
-        "the scene file, a mesh it loads or the glint version differs from the render that made "
-        "it");
+        "the scene differs from the render that made it: the scene file, a file it includes, a "
+        "mesh or texture it loads, or the glint version");
   return std::nullopt;
 }
 

@@ -16,6 +16,7 @@
 #include <limits>
 #include <string>
 
+#include "glint/job/job_steps.h"
 #include "glint/render/renderer.h"
 
 namespace glint {
@@ -252,6 +253,37 @@ TEST(Checkpoint, FingerprintCoversSceneBytesMeshesMaterialsAndEverySetting) {
   EXPECT_NE(base, changed([](CheckpointSettings& t) { t.region.x1 = 31; }));
   EXPECT_NE(base, changed([](CheckpointSettings& t) { t.tileSize = 9; }));
   EXPECT_NE(base, changed([](CheckpointSettings& t) { t.integrator = Integrator::Whitted; }));
+}
+
+// A checkpoint's (and an MPI rank's) fingerprint covers the files the scene includes: a changed
+// texture colour or group in an included file is a changed scene, as an edit of the scene file is.
+TEST(Checkpoint, FingerprintCoversIncludedFiles) {
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / ("glint-fingerprint-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(folder);
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(folder / name) << text;
+  };
+  write("lib.yaml",
+        "textures:\n  chk: {type: checker2d, colors: [\"#e0e0e0\", \"#202020\"]}\n"
+        "materials:\n  floor: {kd: chk}\n");
+  write("scene.yaml",
+        "include: lib.yaml\ncamera: {position: [0, 2, 5], look_at: [0, 0, 0], fov: 40}\n"
+        "image: {width: 16, height: 12}\nlights: [{type: point, position: [0, 5, 5]}]\n"
+        "objects:\n  - {type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: floor}\n");
+  const std::filesystem::path scene = folder / "scene.yaml";
+  const auto fingerprint = [&]() {
+    const Scene built{loadSceneFile(scene, {}).parts};
+    EXPECT_EQ(built.includedFiles().size(), 1u);
+    return renderFingerprint(fingerprintedSceneText(scene, built), built, sampleSettings());
+  };
+  const std::uint64_t before = fingerprint();
+  EXPECT_EQ(before, fingerprint());
+  write("lib.yaml",
+        "textures:\n  chk: {type: checker2d, colors: [\"#00e000\", \"#202020\"]}\n"
+        "materials:\n  floor: {kd: chk}\n");
+  EXPECT_NE(before, fingerprint());
+  std::filesystem::remove_all(folder);
 }
 
 // The settings' bytes are shared by the file, the fingerprint and the MPI handshake: every field

@@ -18,6 +18,11 @@ LoadedScene loadSceneFile(const std::filesystem::path& file, const LoadOptions& 
 // JobError(Failure) when it cannot be read again.
 std::string readSceneFileAgain(const std::filesystem::path& file);
 
+// What a render's fingerprint covers of its scene's text: the scene file's bytes, then for each
+// file it includes (Scene::includedFiles) its path as opened and its bytes, read again — so that a
+// changed included file (a texture's colours, a group's shapes) is a changed scene too.
+std::string fingerprintedSceneText(const std::filesystem::path& file, const Scene& scene);
+
 // The image limits and memory budget (DESIGN.md §7) for the film that will be allocated, checked
 // after the overrides changed the image: a request refused as too large is a bad request (exit 2),
 // refused before any allocation. `request` names what changed the image ("--width 70000"), empty

@@ -163,7 +163,7 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
   if (checkpointPath) {
     const CheckpointSettings settings = checkpointSettingsFor(scene, region, options.tileSize);
     const std::uint64_t fingerprint =
-        renderFingerprint(readSceneFileAgain(spec.scene), scene, settings);
+        renderFingerprint(fingerprintedSceneText(spec.scene, scene), scene, settings);
     if (spec.resume) {
       try {
         resumed = readCheckpoint(*spec.resume, spec.memoryBudget);

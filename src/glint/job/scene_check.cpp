@@ -59,6 +59,18 @@ std::string readSceneFileAgain(const std::filesystem::path& file) {
   return bytes;
 }
 
+std::string fingerprintedSceneText(const std::filesystem::path& file, const Scene& scene) {
+  std::string text = readSceneFileAgain(file);
+  for (const std::filesystem::path& included : scene.includedFiles()) {
+    const std::string bytes = readSceneFileAgain(included);
+    // Each part with its length, so that no two different sets of files give the same text.
+    const std::string name = included.string();
+    text += fmt::format("\ninclude {}:{}\n{}:", name.size(), name, bytes.size());
+    text += bytes;
+  }
+  return text;
+}
+
 void enforceImageLimits(const ImageSettings& image, const std::string& request,
                         std::uint64_t memoryBudget, int filmCopies) {
   std::optional<std::string> refusal = checkImageSettings(image, memoryBudget);

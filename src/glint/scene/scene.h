@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -100,6 +101,9 @@ struct GroupMaterialTakers {
 // fill it directly. Primitive material indices point into `materials`.
 struct SceneParts {
   std::string name;
+  // The files the scene file includes (`include`), as they were opened: they belong to what the
+  // scene is, so a checkpoint's or an MPI rank's fingerprint covers their bytes too.
+  std::vector<std::filesystem::path> includedFiles;
   std::vector<Primitive> primitives;
   std::vector<TriangleMesh> meshes;  // mesh material indices point into `materials`
   std::vector<GroupParts> groups;    // what `instances` place
@@ -130,6 +134,7 @@ class Scene {
   explicit Scene(SceneParts parts);
 
   const std::string& name() const { return name_; }
+  const std::vector<std::filesystem::path>& includedFiles() const { return includedFiles_; }
   const Aggregate& aggregate() const { return aggregate_; }
   const std::vector<Primitive>& primitives() const { return aggregate_.primitives(); }
   const std::vector<Material>& materials() const { return materials_; }
@@ -241,6 +246,7 @@ class Scene {
   std::uint32_t instancedMaterialIndex(const Hit& hit) const;
 
   std::string name_;
+  std::vector<std::filesystem::path> includedFiles_;
   std::vector<Material> materials_;
   std::vector<Texture> textures_;
   std::vector<MaterialTextures> materialTextures_;
