@@ -436,6 +436,23 @@ TEST_F(Cli, AnExrModuleThatCannotLoadFailsBeforeTheRender) {
   EXPECT_FALSE(fs::exists(work_ / "refused.png"));
 }
 
+// An image texture the scene reads is an input too: writing the image over it is refused before
+// the render, and the texture is left as it was.
+TEST_F(Cli, AnOutputThatIsATextureOfTheSceneIsRefused) {
+  fs::copy_file(fs::path(GLINT_SOURCE_DIR) / "scenes" / "textures" / "uv_grid.png",
+                work_ / "tex.png");
+  const std::string texture = readFile(work_ / "tex.png");
+  writeFile(work_ / "own.yaml",
+            "image: {width: 16, height: 12}\ncamera: {position: [0, 0, 3], look_at: [0, 0, 0], "
+            "fov: 40}\nambient: {intensity: 1}\nobjects:\n  - {type: sphere, center: [0, 0, 0], "
+            "radius: 1, material: {ka: {type: image, file: tex.png}}}\n");
+  const RunResult r = run({"render", (work_ / "own.yaml").string(), "-o", "tex.png"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(contains(r.err, "cannot write 'tex.png': the scene reads it")) << r.err;
+  EXPECT_FALSE(contains(r.err, "%")) << "it rendered first: " << r.err;
+  EXPECT_EQ(readFile(work_ / "tex.png"), texture);
+}
+
 // Output paths no image can be written to are wrong arguments (exit 2), refused before the render.
 TEST_F(Cli, OutputPathsThatCannotBeAFileExitTwo) {
   fs::create_directory(work_ / "out.png");

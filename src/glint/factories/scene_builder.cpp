@@ -558,6 +558,7 @@ class Builder {
     try {
       // Estimated (mesh + BVH, with the film) against the memory limit before anything is read.
       if (!file) {
+        parts_.readFiles.push_back(path);
         file = meshCache_.load(
             path,
             MeshBudget{options_.imageMemoryBudget,

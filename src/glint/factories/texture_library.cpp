@@ -219,6 +219,7 @@ std::shared_ptr<const MipMap> TextureLibrary::load(const std::filesystem::path& 
   if (error) key = path.lexically_normal();
   auto& slot = images_[{key.string(), encoding}];
   if (slot != nullptr) return slot;
+  ctx_.parts.readFiles.push_back(path);
   bool floatingPoint = false;
   RgbImage decoded = readImageFile(path, encoding, [&](const ImageHeader& header) {
     checkBudget(header, fmt::format("its {}", formatName(header.format)));

@@ -82,6 +82,17 @@ void checkOutputPath(const fs::path& out, const fs::path& scene,
     throw JobError(JobFailure::Failure, fmt::format("cannot write '{}': {}", out.string(), why));
 }
 
+void checkOutputIsNotRead(const fs::path& output, const std::vector<fs::path>& files) {
+  for (const fs::path& file : files) {
+    if (sameFile(output, file)) {
+      throw JobError(JobFailure::BadInput,
+                     fmt::format("cannot write '{}': the scene reads it (as '{}'); choose another "
+                                 "name for the image",
+                                 output.string(), file.string()));
+    }
+  }
+}
+
 std::optional<fs::path> resolveCheckpointPath(const std::optional<fs::path>& checkpoint,
                                               const std::optional<fs::path>& resume,
                                               const fs::path& out) {

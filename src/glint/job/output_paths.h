@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <vector>
 
 namespace glint {
 
@@ -18,6 +19,12 @@ std::filesystem::path defaultOutputPath(const std::filesystem::path& scene);
 // an unwritable folder). `scene` may be empty (a scene built in code).
 void checkOutputPath(const std::filesystem::path& output, const std::filesystem::path& scene,
                      const std::optional<std::filesystem::path>& resume);
+
+// After the scene is loaded: throws JobError(BadInput) when the output image is one of the files
+// the scene read (`files`: its included files, mesh files and image textures), which writing the
+// image would replace.
+void checkOutputIsNotRead(const std::filesystem::path& output,
+                          const std::vector<std::filesystem::path>& files);
 
 // The checkpoint file a render writes: `checkpoint`, or else the `resume` file (a resumed render
 // keeps checkpointing, so it can be interrupted again); std::nullopt when neither is given. Throws

@@ -116,6 +116,8 @@ RenderJobResult runRenderJob(RenderJobSpec spec, const RenderJobEvents& events) 
   } catch (const Cancelled&) {
     return interrupted();
   }
+  checkOutputIsNotRead(out, parts.includedFiles);
+  checkOutputIsNotRead(out, parts.readFiles);
   if (std::optional<Diagnostic> warning = pixelWorkWarning(sceneName, parts))
     warnings.push_back(std::move(*warning));
   if (events.sceneWarnings && !warnings.empty()) events.sceneWarnings(warnings);

@@ -335,6 +335,7 @@ Color Scene::transmittance(const Ray& ray, double tMax, const MediumStack& start
 Scene::Scene(SceneParts parts)
     : name_((checkTextures(parts), std::move(parts.name))),
       includedFiles_(std::move(parts.includedFiles)),
+      readFiles_(std::move(parts.readFiles)),
       materials_(std::move(parts.materials)),
       textures_(std::move(parts.textures)),
       materialTextures_(std::move(parts.materialTextures)),

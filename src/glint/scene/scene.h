@@ -104,6 +104,9 @@ struct SceneParts {
   // The files the scene file includes (`include`), as they were opened: they belong to what the
   // scene is, so a checkpoint's or an MPI rank's fingerprint covers their bytes too.
   std::vector<std::filesystem::path> includedFiles;
+  // Every other file the scene reads — mesh files and image files (textures, the sky) — as they
+  // were opened; a render's output must not replace one of them.
+  std::vector<std::filesystem::path> readFiles;
   std::vector<Primitive> primitives;
   std::vector<TriangleMesh> meshes;  // mesh material indices point into `materials`
   std::vector<GroupParts> groups;    // what `instances` place
@@ -135,6 +138,7 @@ class Scene {
 
   const std::string& name() const { return name_; }
   const std::vector<std::filesystem::path>& includedFiles() const { return includedFiles_; }
+  const std::vector<std::filesystem::path>& readFiles() const { return readFiles_; }
   const Aggregate& aggregate() const { return aggregate_; }
   const std::vector<Primitive>& primitives() const { return aggregate_.primitives(); }
   const std::vector<Material>& materials() const { return materials_; }
@@ -247,6 +251,7 @@ class Scene {
 
   std::string name_;
   std::vector<std::filesystem::path> includedFiles_;
+  std::vector<std::filesystem::path> readFiles_;
   std::vector<Material> materials_;
   std::vector<Texture> textures_;
   std::vector<MaterialTextures> materialTextures_;
