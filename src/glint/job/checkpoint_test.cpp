@@ -261,6 +261,13 @@ TEST(Checkpoint, FingerprintCoversIncludedFiles) {
   const std::filesystem::path folder =
       std::filesystem::temp_directory_path() / ("glint-fingerprint-" + std::to_string(::getpid()));
   std::filesystem::create_directories(folder);
+  struct RemoveFolder {
+    std::filesystem::path folder;
+    ~RemoveFolder() {
+      std::error_code ignored;
+      std::filesystem::remove_all(folder, ignored);
+    }
+  } removeFolder{folder};
   const auto write = [&](const std::string& name, const std::string& text) {
     std::ofstream(folder / name) << text;
   };
@@ -272,18 +279,21 @@ TEST(Checkpoint, FingerprintCoversIncludedFiles) {
         "image: {width: 16, height: 12}\nlights: [{type: point, position: [0, 5, 5]}]\n"
         "objects:\n  - {type: plane, point: [0, 0, 0], normal: [0, 1, 0], material: floor}\n");
   const std::filesystem::path scene = folder / "scene.yaml";
-  const auto fingerprint = [&]() {
-    const Scene built{loadSceneFile(scene, {}).parts};
+  const auto fingerprint = [&](const std::filesystem::path& named) {
+    const Scene built{loadSceneFile(named, {}).parts};
     EXPECT_EQ(built.includedFiles().size(), 1u);
-    return renderFingerprint(fingerprintedSceneText(scene, built), built, sampleSettings());
+    return renderFingerprint(fingerprintedSceneText(named, built), built, sampleSettings());
   };
-  const std::uint64_t before = fingerprint();
-  EXPECT_EQ(before, fingerprint());
+  const std::uint64_t before = fingerprint(scene);
+  EXPECT_EQ(before, fingerprint(scene));
+  // The same files named another way (relative to the working folder, with a detour): the same
+  // scene, as a resume from another folder or an MPI rank started elsewhere must find.
+  EXPECT_EQ(before, fingerprint(std::filesystem::relative(scene)));
+  EXPECT_EQ(before, fingerprint(folder / "." / ".." / folder.filename() / "scene.yaml"));
   write("lib.yaml",
         "textures:\n  chk: {type: checker2d, colors: [\"#00e000\", \"#202020\"]}\n"
         "materials:\n  floor: {kd: chk}\n");
-  EXPECT_NE(before, fingerprint());
-  std::filesystem::remove_all(folder);
+  EXPECT_NE(before, fingerprint(scene));
 }
 
 // The settings' bytes are shared by the file, the fingerprint and the MPI handshake: every field

@@ -60,11 +60,19 @@ std::string readSceneFileAgain(const std::filesystem::path& file) {
 }
 
 std::string fingerprintedSceneText(const std::filesystem::path& file, const Scene& scene) {
+  namespace fs = std::filesystem;
   std::string text = readSceneFileAgain(file);
-  for (const std::filesystem::path& included : scene.includedFiles()) {
+  std::error_code error;
+  const fs::path folder = fs::absolute(file, error).lexically_normal().parent_path();
+  for (const fs::path& included : scene.includedFiles()) {
     const std::string bytes = readSceneFileAgain(included);
+    // Named from the scene file's folder, so that the text does not depend on the folder glint
+    // runs in or on how the scene was named ("a/scene.yaml" here, "scene.yaml" from a/).
+    const std::string name = fs::absolute(included, error)
+                                 .lexically_normal()
+                                 .lexically_relative(folder)
+                                 .generic_string();
     // Each part with its length, so that no two different sets of files give the same text.
-    const std::string name = included.string();
     text += fmt::format("\ninclude {}:{}\n{}:", name.size(), name, bytes.size());
     text += bytes;
   }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace glint {
@@ -208,15 +209,21 @@ bool usesUv(const Texture& texture) {
 
 namespace {
 
-// The solid checker's cell index along one axis: floor(x / scale), except that a coordinate within
-// 10^-12 (relative) of a cell boundary counts as on it. A face lying on a boundary (a unit box's
-// sides under a checker of scale 0.5) is hit exactly on it when the box is untransformed, but a
-// transformed one's hit point comes back through the inverse transform with an error of a few
-// ulps either side, and floor alone then flips between the two cells from pixel to pixel.
-double checkerCell(double offset, double scale) {
-  const double x = tame(offset / scale);
+// The solid checker's cell index along one axis: floor((coordinate − center) / scale), except
+// that a value within the rounding of its inputs of a cell boundary counts as on it. A face lying
+// on a boundary (a unit box's sides under a checker of scale 0.5) is hit exactly on it when the
+// box is untransformed, but a transformed one's hit point comes back through the inverse transform
+// a few ulps either side, and floor alone then flips between the two cells from pixel to pixel.
+// The slack is 64 ulps of the coordinate, the center and a cell (near the origin the errors are
+// those of the object's size, not of zero), in cells, and never more than 1e-6 of a cell: where
+// rounding errors are larger than that, no snapping could make a face one colour.
+double checkerCell(double coordinate, double center, double scale) {
+  const double x = tame((coordinate - center) / scale);
   const double boundary = std::nearbyint(x);
-  if (std::abs(x - boundary) <= 1e-12 * std::max(1.0, std::abs(x))) return boundary;
+  constexpr double kUlp = std::numeric_limits<double>::epsilon();
+  const double slack =
+      std::min(64 * kUlp * (std::abs(coordinate) + std::abs(center) + scale) / scale, 1e-6);
+  if (std::abs(x - boundary) <= slack) return boundary;
   return std::floor(x);
 }
 
@@ -227,8 +234,8 @@ Color evaluate(const Texture& texture, const TextureLookup& at) {
   if (const auto* t = std::get_if<CheckerTexture>(&texture)) {
     const Point3& p = at.objectPoint;
     const Point3& c = t->center;
-    const double cells = checkerCell(p.x - c.x, t->scale) + checkerCell(p.y - c.y, t->scale) +
-                         checkerCell(p.z - c.z, t->scale);
+    const double cells = checkerCell(p.x, c.x, t->scale) + checkerCell(p.y, c.y, t->scale) +
+                         checkerCell(p.z, c.z, t->scale);
     return t->colors[std::fmod(std::abs(cells), 2.0) == 1 ? 1 : 0];
   }
   if (const auto* t = std::get_if<Checker2dTexture>(&texture)) return evaluateChecker2d(*t, at);

@@ -124,6 +124,12 @@ TEST(Texture, SolidCheckerPointsWithinRoundingOfABoundaryTakeItsCell) {
       EXPECT_EQ(colorAt(boundary + 0.5e-6), exact) << boundary;
     }
   }
+  // Far from the origin in cells (a tiny scale), points well inside a cell keep their cell: the
+  // slack never grows past a millionth of a cell.
+  const Texture fine = CheckerTexture{{Color(0.1), Color(0.9)}, 1e-6, Point3{}};
+  const auto fineAt = [&](double x) { return evaluate(fine, {Point3{x, 0, 0}, {}, {}, {}}).r; };
+  EXPECT_EQ(fineAt(0.5 + 0.3e-6), fineAt(0.5 + 0.7e-6));  // cells 500000.3 and .7: one cell
+  EXPECT_NE(fineAt(0.5 + 0.7e-6), fineAt(0.5 + 1.2e-6));
 }
 
 TEST(Texture, Checker2dAppliesRepeatOffsetAndRotation) {
