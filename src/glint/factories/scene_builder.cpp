@@ -395,6 +395,13 @@ class Builder {
     if (type == "instance") {
       params.declare({"material", "transform"});  // no emission: its objects have their own
       const MaterialChoice material = resolveMaterial(params, type);
+      if (material.emission) {
+        // The override replaces its objects' material index only; their emission stays theirs.
+        params.error(params.find("material")->where,
+                     "instance.material: this material has an emission, which an instance cannot "
+                     "give the objects it places (they keep their own); use a material without "
+                     "emission, or give the group's objects the material");
+      }
       const TransformResult transform = readTransform(params, type);
       buildInstance(params, path, material, transform);
       params.finish();
@@ -595,7 +602,7 @@ class Builder {
     if (!file->ignoredTextures.empty()) {
       std::vector<std::string> ignoredShown;
       for (const std::string& ignored : file->ignoredTextures) {
-        ignoredShown.push_back(escapeForMessage(ignored));
+        ignoredShown.push_back(shortenForMessage(ignored));  // the reader's text: not trusted
       }
       sink_.warning(params.location(),
                     fmt::format("{}: its materials' {} {} not used (glint reads map_Kd, map_Ks, "

@@ -257,6 +257,13 @@ TEST(SceneBuilder, AMaterialsEmissionIsItsObjectsEmission) {
   const auto emissionOfOperand = [&](std::size_t i) { return csg.tree->operands.at(i).emission; };
   EXPECT_EQ(emissionOfOperand(0), Color(2, 1, 0.5));
   EXPECT_EQ(emissionOfOperand(1), Color());
+  // An instance's material override changes its objects' materials, not their emission: a
+  // material with an emission is refused there rather than half applied.
+  expectOneError(std::string(kMinimal) +
+                     "materials:\n  lamp: {emission: 1}\n"
+                     "groups:\n  g: [{type: sphere, center: [0, 0, 0], radius: 1}]\n"
+                     "objects:\n  - {type: instance, group: g, material: lamp}\n",
+                 8, 42, "instance.material: this material has an emission");
 }
 
 TEST(SceneBuilder, DefaultsForOptionalKeys) {

@@ -11,13 +11,13 @@
 #include <string>
 #include <vector>
 
-#include "glint/mesh/mesh_file.h"
 #include "glint/core/version.h"
+#include "glint/mesh/mesh_file.h"
 
 namespace glint::wire {
 
 // The first argument of the reader program: a reader from another glint build refuses to answer.
-inline constexpr const char* kMeshReaderProtocol = "glint-mesh-reader/" GLINT_VERSION "/1";
+inline constexpr const char* kMeshReaderProtocol = "glint-mesh-reader/" GLINT_VERSION "/2";
 
 // Writes everything or stops silently (the parent sees a short message).
 inline bool writeAll(int fd, const void* data, std::size_t size) {
@@ -48,7 +48,8 @@ inline bool writeMessage(int fd, char tag, const std::string& text) {
          writeAll(fd, text.data(), text.size());
 }
 
-// The whole answer: 'M', then the file's materials, embedded images and parts.
+// The whole answer: 'M', the dropped triangles, the textures the materials name that glint does not
+// use, then the file's materials, embedded images and parts.
 bool writeMeshFile(int fd, const MeshFile& file);
 
 }  // namespace glint::wire

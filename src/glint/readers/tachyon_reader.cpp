@@ -143,7 +143,7 @@ class TachyonReader {
       const Token alias = in_.need(t, "the alias name");
       requireTextureName(t, alias);
       const Token original = in_.need(t, "the texture it names");
-      textures_.alias(std::string(alias.text), original);
+      textures_.alias(std::string(alias.text), alias.at, original);
     } else if (word == "SPHERE" || word == "FCYLINDER" || word == "CYLINDER" || word == "RING" ||
                word == "PLANE" || word == "BOX") {
       geometry_.shape(t, word);

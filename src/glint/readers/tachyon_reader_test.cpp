@@ -301,8 +301,29 @@ TEST(TachyonReader, ATexdefOfADefinedNameKeepsTheFirst) {
   }
   ASSERT_EQ(r.diagnostics.size(), 1u);
   EXPECT_EQ(r.diagnostics[0].format(),
-            "redef.dat:5:8: warning: TEXDEF 'a' is already defined (line 3); as Tachyon does, "
-            "the first definition is kept");
+            "redef.dat:5:8: warning: TEXDEF 'a': the name is already defined (line 3); as Tachyon "
+            "does, the first definition is kept");
+  // TEXALIAS names count alike, both ways.
+  const ParseResult aliases = parseTachyon(
+      "Begin_Scene\nResolution 8 8\n"
+      "Texdef red Ambient 0 Diffuse 1 Specular 0 Opacity 1 Color 1 0 0 TexFunc 0\n"
+      "Texdef blue Ambient 0 Diffuse 1 Specular 0 Opacity 1 Color 0 0 1 TexFunc 0\n"
+      "TexAlias a red\nTexAlias a blue\n"
+      "Texdef a Ambient 0 Diffuse 1 Specular 0 Opacity 1 Color 0 1 0 TexFunc 0\n"
+      "Sphere Center 0 0 5 Rad 1 a\nEnd_Scene\n",
+      "alias.dat");
+  ASSERT_FALSE(aliases.hasErrors()) << firstError(aliases);
+  ASSERT_EQ(aliases.diagnostics.size(), 2u);
+  EXPECT_EQ(aliases.diagnostics[0].format(),
+            "alias.dat:6:10: warning: TEXALIAS 'a': the name is already defined (line 5); as "
+            "Tachyon does, the first definition is kept");
+  EXPECT_EQ(aliases.diagnostics[1].format(),
+            "alias.dat:7:8: warning: TEXDEF 'a': the name is already defined (line 5); as Tachyon "
+            "does, the first definition is kept");
+  const LoadedScene aliased = buildDescribedScene(aliases);
+  ASSERT_EQ(aliased.parts.primitives.size(), 1u);
+  EXPECT_EQ(aliased.parts.materials[aliased.parts.primitives[0].materialIndex()].kd,
+            Color(1, 0, 0));
 }
 
 // Triangles of one texture on fewer than three distinct points (vertices written alike are one)

@@ -338,14 +338,7 @@ void Textures::emitPattern(std::string_view key, const Texture& t, double factor
 
 void Textures::define(const std::string& name, const Texture& texture, const TextPosition& at,
                       bool transVmd) {
-  // Tachyon looks a name up in the order the textures were defined: the first definition wins.
-  if (const auto it = definedAt_.find(name); it != definedAt_.end()) {
-    out_.warning(at, fmt::format("TEXDEF {} is already defined (line {}); as Tachyon does, the "
-                                 "first definition is kept",
-                                 quoteForMessage(name), it->second.line));
-    return;
-  }
-  definedAt_.emplace(name, at);
+  if (alreadyDefined("TEXDEF", name, at)) return;
   std::string material = name;
   if (materialNames_.count(material) > 0) {
     int& k = nextSuffix_.try_emplace(name, 2).first->second;
@@ -358,7 +351,19 @@ void Textures::define(const std::string& name, const Texture& texture, const Tex
   definitions_[name] = texture;
 }
 
-void Textures::alias(const std::string& alias, const Token& original) {
+bool Textures::alreadyDefined(std::string_view statement, const std::string& name,
+                              const TextPosition& at) {
+  // Tachyon looks a name up in the order names were defined (TEXDEF and TEXALIAS alike): the
+  // first definition wins.
+  const auto [it, added] = definedAt_.emplace(name, at);
+  if (added) return false;
+  out_.warning(at, fmt::format("{} {}: the name is already defined (line {}); as Tachyon does, "
+                               "the first definition is kept",
+                               statement, quoteForMessage(name), it->second.line));
+  return true;
+}
+
+void Textures::alias(const std::string& alias, const TextPosition& at, const Token& original) {
   const auto it = named_.find(std::string(original.text));
   if (it == named_.end()) {
     out_.error(original.at, fmt::format("TEXALIAS: undefined texture {} (define it with TEXDEF "
@@ -366,6 +371,7 @@ void Textures::alias(const std::string& alias, const Token& original) {
                                         quoteForMessage(original.text)));
     throw SyntaxError{};
   }
+  if (alreadyDefined("TEXALIAS", alias, at)) return;
   named_[alias] = it->second;
   definitions_[alias] = definitions_[std::string(original.text)];
 }

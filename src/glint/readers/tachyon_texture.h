@@ -80,7 +80,9 @@ class Textures {
   // Tachyon keeps the first).
   void define(const std::string& name, const Texture& texture, const TextPosition& at,
               bool transVmd);
-  void alias(const std::string& alias, const Token& original);
+  // TEXALIAS: `alias` (written at `at`) names what `original` names (a name already defined is
+  // ignored with a warning, as for TEXDEF).
+  void alias(const std::string& alias, const TextPosition& at, const Token& original);
   // An object's texture: TEXTURE body or a name; the name of its material.
   std::string reference(const Token& statement, bool vertexColors, bool transVmd);
   // The material of a texture (shared by equal textures).
@@ -97,6 +99,9 @@ class Textures {
 
  private:
   std::string emitMaterial(const Texture& texture, bool transVmd, const std::string& name);
+  // Whether `name` was defined before (by TEXDEF or TEXALIAS): then a warning at `at`; else it is
+  // recorded as defined there.
+  bool alreadyDefined(std::string_view statement, const std::string& name, const TextPosition& at);
   // key: a glint texture mapping for the texture's TEXFUNC, its colours times `factor`.
   void emitPattern(std::string_view key, const Texture& t, double factor, const TextPosition& at);
   Input& in_;
@@ -104,13 +109,14 @@ class Textures {
   std::map<std::string, std::string> named_;       // TEXDEF and TEXALIAS names → material names
   std::map<std::string, std::string> byValues_;    // a material's values → its name
   std::map<std::string, Texture> definitions_;     // TEXDEF name → its texture (vertex colours)
-  std::map<std::string, TextPosition> definedAt_;  // TEXDEF name → where it was defined
+  std::map<std::string, TextPosition> definedAt_;  // TEXDEF/TEXALIAS name → where it was defined
   void requireRange(const Number& n, double lo, double hi, std::string_view what);
 
   std::set<std::string> materialNames_;  // every material emitted
   bool ambientOcclusion_ = false;
-  // Per TEXDEF name defined again, the suffix to try next (name_2, name_3...): names are never
-  // freed, so every smaller suffix is taken and a redefinition costs no search from 2.
+  // Per TEXDEF name that a material has already (one named for an inline texture: texture1...),
+  // the suffix to try next (name_2, name_3...): names are never freed, so every smaller suffix is
+  // taken and the next clash costs no search from 2.
   std::map<std::string, int> nextSuffix_;
   std::size_t generated_ = 0;
 };
