@@ -77,7 +77,12 @@ cmp "$work/mesh-lib.exr" "$work/mesh-cmd.exr" ||
   fail "the library's program and the command render scenes/mesh.yaml to other EXR bytes"
 # Outside the prefix (and outside the build tree) the helpers are not found, and the error says
 # how to name them, unless glint was configured for an install prefix that holds them.
-if [[ ! -e /usr/local/libexec/glint/glint-mesh-reader && ! -e /usr/libexec/glint/glint-mesh-reader ]]; then
+configured="$(sed -n 's/^CMAKE_INSTALL_PREFIX:[A-Z]*=//p' "$build/CMakeCache.txt")"
+found_elsewhere=false
+for installed in "${configured:-/usr/local}" /usr; do
+  [[ -e "$installed/libexec/glint/glint-mesh-reader" ]] && found_elsewhere=true
+done
+if ! $found_elsewhere; then
   if "$work/examples/render_scene_file" "$source/scenes/mesh.yaml" "$work/nowhere.png" 32 \
     >/dev/null 2>"$work/nowhere.log"; then
     fail "a program outside the prefix found a mesh reader: the build tree's?"

@@ -114,7 +114,10 @@ void ProgressReporter::drawBar(std::size_t done, std::size_t total, double elaps
   if (columns != 0 && line.size() >= columns) line.resize(columns - 1);
   // Blanks overwrite the end of a longer previous line (an ETA in minutes, say).
   const std::size_t length = line.size();
-  if (length < barLength_) line.append(barLength_ - length, ' ');
+  // Blanks over the rest of a longer previous drawing, within the terminal (it may have shrunk).
+  std::size_t pad = barLength_ > length ? barLength_ - length : 0;
+  if (columns != 0) pad = std::min(pad, columns - 1 - std::min(length, columns - 1));
+  line.append(pad, ' ');
   barLength_ = length;
   emit(stream_, "\r" + line);
   barDrawn_ = true;

@@ -23,10 +23,11 @@ std::filesystem::path findHelperFile(std::string_view name, const char* override
     candidates.push_back(self.parent_path().parent_path() / "libexec/glint" / name);
   }
   if (!paths.build.empty() && !error) {
-    // The build tree's helper: for programs of that tree only (the helper lies at its top).
+    // The build tree's helper: for programs of that tree only.
     std::error_code canonicalError;
-    const fs::path buildTree =
-        fs::weakly_canonical(fs::path(paths.build).parent_path(), canonicalError);
+    const fs::path buildTree = fs::weakly_canonical(
+        paths.buildTree.empty() ? fs::path(paths.build).parent_path() : fs::path(paths.buildTree),
+        canonicalError);
     const bool insideTree =
         !canonicalError && !buildTree.empty() &&
         std::mismatch(buildTree.begin(), buildTree.end(), self.begin(), self.end()).first ==

@@ -19,6 +19,11 @@ namespace glint {
 #else
 #define GLINT_HELPER_BUILD_PATH_OR_EMPTY ""
 #endif
+#ifdef GLINT_HELPER_BUILD_TREE
+#define GLINT_HELPER_BUILD_TREE_OR_EMPTY GLINT_HELPER_BUILD_TREE
+#else
+#define GLINT_HELPER_BUILD_TREE_OR_EMPTY ""
+#endif
 #ifdef GLINT_HELPER_INSTALL_PATH
 #define GLINT_HELPER_INSTALL_PATH_OR_EMPTY GLINT_HELPER_INSTALL_PATH
 #else
@@ -30,25 +35,27 @@ namespace glint {
 #define GLINT_HELPER_PACKAGE_PATH_OR_EMPTY ""
 #endif
 // The three, for findHelperFile and loadHelperModule.
-#define GLINT_HELPER_PATHS                                                \
-  ::glint::HelperPaths {                                                  \
-    GLINT_HELPER_BUILD_PATH_OR_EMPTY, GLINT_HELPER_INSTALL_PATH_OR_EMPTY, \
-        GLINT_HELPER_PACKAGE_PATH_OR_EMPTY                                \
+#define GLINT_HELPER_PATHS                                                     \
+  ::glint::HelperPaths {                                                       \
+    GLINT_HELPER_BUILD_PATH_OR_EMPTY, GLINT_HELPER_BUILD_TREE_OR_EMPTY,        \
+        GLINT_HELPER_INSTALL_PATH_OR_EMPTY, GLINT_HELPER_PACKAGE_PATH_OR_EMPTY \
   }
 
 // Where a helper was put by the build and by the installs (any may be empty).
 struct HelperPaths {
-  std::string_view build;    // the build tree's
-  std::string_view install;  // the configured install prefix's (cmake --install)
-  std::string_view package;  // the .deb's (/usr)
+  std::string_view build;      // the build tree's
+  std::string_view buildTree;  // the top of the build tree whose programs may use `build`
+  std::string_view install;    // the configured install prefix's (cmake --install)
+  std::string_view package;    // the .deb's (/usr)
 };
 
 // The helper `name`: the path in environment variable `override` when it is set and not empty
 // (returned whether or not it exists, so that a wrong setting is reported as such); else the first
 // regular file that exists of: `name` beside the running program (a build tree, a program linked
 // with the library), ../libexec/glint/`name` from it (an installed tree, wherever it was moved),
-// the build tree's — only for a program inside that build tree (its tests and tools: an installed
-// library never runs what a build folder happens to hold) —, the configured install prefix's and
+// the build tree's — only for a program inside that build tree (its tests and tools, a project
+// that builds glint with add_subdirectory: an installed library never runs what a build folder
+// happens to hold) —, the configured install prefix's and
 // the .deb's. Empty when none is found. `executable`: whether it must be executable (a program,
 // not a module).
 std::filesystem::path findHelperFile(std::string_view name, const char* override,

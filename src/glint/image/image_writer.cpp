@@ -309,7 +309,15 @@ class ExrWriter final : public ImageWriter {
     };
     error = codec->write(temp.path().c_str(), width, height, red.data(), green.data(), blue.data(),
                          kExrRowsPerCall, rowsWritten);
-    if (!error.empty()) fail(path, error);
+    if (!error.empty()) {
+      // OpenEXR's own words name the file it was given: the temporary one, not the user's.
+      const std::string temporary = temp.path().string();
+      for (std::size_t at = error.find(temporary); at != std::string::npos;
+           at = error.find(temporary, at + path.string().size())) {
+        error.replace(at, temporary.size(), path.string());
+      }
+      fail(path, error);
+    }
     if (cancelled) throw Cancelled();
     if (callbackError) std::rethrow_exception(callbackError);
     temp.commit();

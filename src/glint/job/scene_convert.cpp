@@ -149,6 +149,14 @@ ConvertResult convertScene(const ConvertSpec& spec) {
     for (const WrittenScene::File& file : written.files) {
       files.emplace_back(folder / file.name, &file.bytes);
       checkTarget(files.back().first);
+      // The writer skipped names the scene reads; this catches the same file reached another way
+      // (a symbolic link, a hard link).
+      if (readByScene(files.back().first, written.inputs)) {
+        throw JobError(JobFailure::BadInput,
+                       fmt::format("{}: the scene being converted reads this file; choose another "
+                                   "name for the output",
+                                   files.back().first.string()));
+      }
     }
     files.emplace_back(result.output, &written.yaml);
     writeAllOrNothing(files, spec);

@@ -255,8 +255,8 @@ namespace {
 // version is refused.
 
 // The mesh reader program (core/helper_files.h): GLINT_MESH_READER when set, beside the running
-// program, ../libexec/glint from it, the build tree the library was built in, the installed
-// libexec folder.
+// program, ../libexec/glint from it, the build tree's (for programs of that build), the installed
+// and the packaged libexec folders.
 std::filesystem::path findMeshReader() {
   return findHelperFile(kMeshReaderProgram, "GLINT_MESH_READER", GLINT_HELPER_PATHS, true);
 }

@@ -69,7 +69,7 @@ class NffReader {
     }
     // NFF has no end marker: a file cut inside its last number ("0.0555556" as "0.05") reads as
     // a whole file. The generators end every line with a line break.
-    if (last && !text_.empty() && text_.back() != '\n' && text_.back() != '\r') {
+    if (last && endsInsideAStatement()) {
       out_.warning(last->at,
                    "the file does not end with a line break: if it was cut short, the "
                    "last statement's numbers may be incomplete");
@@ -597,6 +597,18 @@ class NffReader {
     }
     out.push_back({ring[0], ring[1], ring[2]});
     return out;
+  }
+
+  // Whether the text's last line has no line break after it and ends in a value (not in blanks
+  // or a comment).
+  bool endsInsideAStatement() const {
+    if (text_.empty() || text_.back() == '\n' || text_.back() == '\r') return false;
+    const std::size_t lineStart = text_.find_last_of("\r\n") + 1;  // npos + 1 = 0
+    const std::string_view line = text_.substr(lineStart);
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first == std::string_view::npos || line[first] == '#') return false;
+    const char lastChar = line.back();
+    return lastChar != ' ' && lastChar != '\t';
   }
 
   std::string_view text_;

@@ -181,6 +181,8 @@ TEST(NffReader, PolygonsThatCrossThemselvesOrBendAreWarnedAbout) {
                                      "break: if it was cut short, the last statement's numbers "
                                      "may be incomplete"});
   EXPECT_TRUE(warningsOf(parseNff(view + "s 0 0 0 0.05\r\n", "a.nff")).empty());
+  EXPECT_TRUE(warningsOf(parseNff(view + "s 0 0 0 0.05\n# the end", "a.nff")).empty());
+  EXPECT_TRUE(warningsOf(parseNff(view + "s 0 0 0 0.05   ", "a.nff")).empty());
   // A number below the smallest double is 0 (as in YAML scenes), one above the largest an error.
   {
     const ParseResult tiny = parseNff(view + "s 0 0 0 1\ns 0 1e-400 0 1\n", "a.nff");

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "glint/readers/spelling.h"
+#include "glint/readers/text_statements.h"
 
 namespace glint {
 
@@ -41,8 +42,7 @@ std::optional<double> parseDouble(std::string_view text) {
   if (ptr != end) return std::nullopt;
   if (ec == std::errc::result_out_of_range) {
     // from_chars leaves the value unset; strtod says which way it is out of range.
-    const std::string copy(text);
-    return std::strtod(copy.c_str(), nullptr);
+    return outOfRangeNumber(text);
   }
   if (ec != std::errc()) return std::nullopt;
   return value;

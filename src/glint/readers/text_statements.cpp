@@ -1,5 +1,7 @@
 #include "glint/readers/text_statements.h"
 
+#include <locale.h>
+
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -95,15 +97,22 @@ std::optional<double> parseNumber(std::string_view text) {
   const auto [ptr, ec] = std::from_chars(text.data(), end, value);
   if (ptr != end) return std::nullopt;
   if (ec == std::errc::result_out_of_range) {
-    // from_chars leaves the value unset; strtod rounds as YAML's numbers do (parameter_dictionary):
-    // an underflow ("1e-400") is 0 or a subnormal, an overflow infinite and refused.
-    const std::string copy(text);
-    value = std::strtod(copy.c_str(), nullptr);
+    // from_chars leaves the value unset; an underflow ("1e-400") is 0 or a subnormal, as in YAML
+    // scenes (parameter_dictionary), an overflow infinite and refused.
+    value = outOfRangeNumber(text);
   } else if (ec != std::errc()) {
     return std::nullopt;
   }
   if (!std::isfinite(value)) return std::nullopt;
   return value;
+}
+
+double outOfRangeNumber(std::string_view text) {
+  // strtod follows LC_NUMERIC: a library user's "de_DE" locale would stop "1.5e-400" at the '.'.
+  static const locale_t cLocale = ::newlocale(LC_ALL_MASK, "C", nullptr);
+  const std::string copy(text);
+  return cLocale != nullptr ? ::strtod_l(copy.c_str(), nullptr, cLocale)
+                            : std::strtod(copy.c_str(), nullptr);
 }
 
 std::string numberText(double value) {

@@ -56,6 +56,11 @@ class Tokenizer {
 // scene factories parse numbers; nullopt for anything else, and for NaN and infinities.
 std::optional<double> parseNumber(std::string_view text);
 
+// A number std::from_chars found out of range (`text` as it took it), rounded as C's strtod in
+// the "C" locale rounds it (whatever the program's locale): 0 or a subnormal for an underflow,
+// an infinity for an overflow.
+double outOfRangeNumber(std::string_view text);
+
 // Shortest text that reads back as exactly `value` (for values a reader computes, e.g. kd = Kd ·
 // colour); "-0" is written "0".
 std::string numberText(double value);

@@ -41,10 +41,22 @@ class Writer {
   void write() {
     std::string& y = out_.yaml;
     if (!options_.sourceName.empty()) {
-      // A comment ends at a line break: one in the file's name would start a line of YAML.
-      std::string name = options_.sourceName;
-      for (char& c : name) {
-        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+      // A comment ends at a line break: one in the file's name would start a line of YAML. So do
+      // for libyaml NEL (U+0085), LINE SEPARATOR and PARAGRAPH SEPARATOR (U+2028, U+2029).
+      std::string name;
+      const std::string_view source = options_.sourceName;
+      for (std::size_t i = 0; i < source.size(); ++i) {
+        const std::string_view rest = source.substr(i);
+        if (rest.starts_with("\xC2\x85")) {
+          name += '?';
+          i += 1;
+        } else if (rest.starts_with("\xE2\x80\xA8") || rest.starts_with("\xE2\x80\xA9")) {
+          name += '?';
+          i += 2;
+        } else {
+          const char c = source[i];
+          name += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
+        }
       }
       y += fmt::format("# glint scene converted by `glint convert` from {}\n", name);
     }
