@@ -109,7 +109,7 @@ std::optional<Texture> TextureLibrary::readMapping(const ValueReader& reader, Va
                    fmt::format("{}.type: expected a texture type ({}), got {}", path, typeList(),
                                reader.describe(type)));
     } else {
-      reader.error(type, fmt::format("unknown texture type {}; expected one of: {}{}",
+      reader.error(type, fmt::format("{}: unknown texture type {}; expected one of: {}{}", path,
                                      quoteForMessage(tree.scalar(type)), typeList(),
                                      didYouMean(tree.scalar(type), typeNames())));
     }
