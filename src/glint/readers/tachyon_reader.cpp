@@ -39,7 +39,10 @@ const std::vector<std::string_view> kUnsupported = {
 constexpr std::size_t kStatementsPerPoll = 1024;
 
 // The supported statement nearest to `word` (always one).
-std::string_view nearestSupported(std::string_view word) {
+// " (the nearest supported statement is X)" when a supported statement is near enough to be meant
+// (at most half the word's letters differ, or two: SPHEREARRAY → SPHERE, SPHER → SPHERE), else
+// nothing (INCLUDE is not PLANE).
+std::string nearestSupported(std::string_view word) {
   // The distance is quadratic in the word's length: a statement is never longer than this.
   constexpr std::size_t kLongestWord = 64;
   word = word.substr(0, kLongestWord);
@@ -52,7 +55,8 @@ std::string_view nearestSupported(std::string_view word) {
       bestDistance = d;
     }
   }
-  return best;
+  if (bestDistance > std::max<std::size_t>(2, word.size() / 2)) return {};
+  return fmt::format(" (the nearest supported statement is {})", best);
 }
 
 struct Camera {
@@ -152,14 +156,12 @@ class TachyonReader {
     } else if (word == "VERTEXARRAY") {
       geometry_.vertexArray(t);
     } else if (std::find(kUnsupported.begin(), kUnsupported.end(), word) != kUnsupported.end()) {
-      out_.error(t.at, fmt::format("the Tachyon statement {} is not supported by glint (the "
-                                   "nearest supported statement is {})",
-                                   t.text, nearestSupported(word)));
+      out_.error(t.at, fmt::format("the Tachyon statement {} is not supported by glint{}", t.text,
+                                   nearestSupported(word)));
       throw SyntaxError{};
     } else {
-      out_.error(t.at, fmt::format("unknown Tachyon statement {} (the nearest supported statement "
-                                   "is {})",
-                                   quoteForMessage(t.text), nearestSupported(word)));
+      out_.error(t.at, fmt::format("unknown Tachyon statement {}{}", quoteForMessage(t.text),
+                                   nearestSupported(word)));
       throw SyntaxError{};
     }
   }
