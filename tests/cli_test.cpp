@@ -701,9 +701,15 @@ TEST_F(Cli, QuietStillPrintsErrors) {
 TEST_F(Cli, StatsAddsDetails) {
   const RunResult r = run({"render", small(), "-o", "out.png", "--stats", "--threads", "2"});
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* part :
-       {"4 primitives", "4 samples per pixel", "2 threads", "non-finite samples: 0"})
+  for (const char* part : {"4 primitives", "0 meshes (0 triangles)", "4 samples per pixel",
+                           "2 threads", "non-finite samples: 0"})
     EXPECT_TRUE(contains(r.err, part)) << part << " missing in:\n" << r.err;
+  // The meshes are counted too (a scene of mesh files is not "1 primitive").
+  const RunResult meshes =
+      run({"render", (fs::path(GLINT_SOURCE_DIR) / "scenes/mesh.yaml").string(), "-o", "mesh.png",
+           "--width", "32", "--stats"});
+  ASSERT_EQ(meshes.status, 0) << meshes.err;
+  EXPECT_TRUE(contains(meshes.err, "2 meshes (76800 triangles)")) << meshes.err;
 }
 
 // --isa and GLINT_ISA (core/isa.h): the instruction set of the BVH queries, shown by --stats; a

@@ -273,10 +273,14 @@ void printStats(const RenderJobResult& result, int threads) {
   const auto pixels = static_cast<double>(std::max<std::uint64_t>(result.pixelsRendered, 1));
   std::string text;
   text += fmt::format(
-      "glint: scene: {} primitives ({} in the BVH, {} unbounded), {} materials, "
-      "lights: {}\n",
-      scene.objects, scene.objects - scene.unboundedObjects, scene.unboundedObjects,
-      scene.materials, lightsText(scene));
+      "glint: scene: {} primitives ({} in the BVH, {} unbounded), {} meshes ({} triangles), {} "
+      "materials, lights: {}\n",
+      scene.objects, scene.objects - scene.unboundedObjects, scene.unboundedObjects, scene.meshes,
+      scene.triangles, scene.materials, lightsText(scene));
+  if (scene.instances > 0) {
+    text += fmt::format("glint: instances: {} of {} groups ({} triangles in the groups)\n",
+                        scene.instances, scene.groups, scene.groupTriangles);
+  }
   text += fmt::format("glint: bounds: {}\n", boundsText(scene));
   text += fmt::format("glint: image: {}, {}, {} {}, {} integrator, max depth {}, seed {}\n",
                       regionText(scene, result.crop), samplesText(scene), threads,
