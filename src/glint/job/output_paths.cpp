@@ -19,8 +19,8 @@ fs::path folderOf(const fs::path& path) {
   return path.parent_path().empty() ? fs::path(".") : path.parent_path();
 }
 
-// Whether two paths name the same file: the same inode when both exist (hard links, symbolic
-// links and "./" spellings included), or the same absolute path spelled lexically.
+}  // namespace
+
 bool sameFile(const fs::path& a, const fs::path& b) {
   std::error_code error;
   if (fs::equivalent(a, b, error)) return true;
@@ -31,7 +31,23 @@ bool sameFile(const fs::path& a, const fs::path& b) {
   return absoluteA.lexically_normal() == absoluteB.lexically_normal();
 }
 
-}  // namespace
+std::string targetProblem(const fs::path& target) {
+  std::error_code error;
+  if (fs::is_directory(target, error)) return "it is a folder";
+  const fs::path folder = folderOf(target);
+  if (!fs::is_directory(folder, error)) {
+    return fs::exists(folder, error)
+               ? fmt::format("'{}' is not a folder", folder.string())
+               : fmt::format("the folder '{}' does not exist", folder.string());
+  }
+  // A name the file system cannot hold would fail only when the finished file is renamed.
+  const long nameMax = ::pathconf(folder.c_str(), _PC_NAME_MAX);
+  if (nameMax > 0 && target.filename().string().size() > static_cast<std::size_t>(nameMax)) {
+    return fmt::format("the file name is {} bytes long, longer than the {} its folder allows",
+                       target.filename().string().size(), nameMax);
+  }
+  return {};
+}
 
 fs::path defaultOutputPath(const fs::path& scene) { return scene.stem().concat(".png"); }
 
@@ -50,22 +66,10 @@ void checkOutputPath(const fs::path& out, const fs::path& scene,
                                extension.empty() ? std::string("the name has no extension")
                                                  : "unknown image format '" + extension + "'"));
   }
-  const fs::path folder = folderOf(out);
-  if (!fs::is_directory(folder, error)) {
-    const bool exists = fs::exists(folder, error);
-    throw JobError(
-        JobFailure::BadInput,
-        fmt::format("cannot write '{}': {}", out.string(),
-                    exists ? fmt::format("'{}' is not a folder", folder.string())
-                           : fmt::format("the folder '{}' does not exist", folder.string())));
-  }
-  // A name the file system cannot hold would fail only when the finished image is renamed.
-  const long nameMax = ::pathconf(folder.c_str(), _PC_NAME_MAX);
-  if (nameMax > 0 && out.filename().string().size() > static_cast<std::size_t>(nameMax))
+  if (const std::string problem = targetProblem(out); !problem.empty())
     throw JobError(JobFailure::BadInput,
-                   fmt::format("cannot write '{}': the file name is {} bytes long, longer than "
-                               "the {} its folder allows",
-                               out.string(), out.filename().string().size(), nameMax));
+                   fmt::format("cannot write '{}': {}", out.string(), problem));
+  const fs::path folder = folderOf(out);
   // The image replaces its target only when complete, but it would still replace an input.
   if (!scene.empty() && sameFile(out, scene))
     throw JobError(JobFailure::BadInput,

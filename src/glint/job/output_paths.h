@@ -20,6 +20,15 @@ std::filesystem::path defaultOutputPath(const std::filesystem::path& scene);
 void checkOutputPath(const std::filesystem::path& output, const std::filesystem::path& scene,
                      const std::optional<std::filesystem::path>& resume);
 
+// Why no file can be written at `target` — it is a folder, its folder does not exist or is not a
+// folder, its name is longer than the file system allows — worded to follow "cannot write 'X': ";
+// empty when nothing stands in the way. Shared by the image's and `glint convert`'s outputs.
+std::string targetProblem(const std::filesystem::path& target);
+
+// Whether `a` and `b` name the same file: the same inode when both exist (hard and symbolic links,
+// "./" spellings), else the same absolute path spelled lexically.
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b);
+
 // After the scene is loaded: throws JobError(BadInput) when the output image is one of the files
 // the scene read (`files`: its included files, mesh files and image textures), which writing the
 // image would replace.

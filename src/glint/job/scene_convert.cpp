@@ -1,7 +1,6 @@
 #include "glint/job/scene_convert.h"
 
-#include <unistd.h>
-
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <memory>
@@ -16,6 +15,7 @@
 #include "glint/core/cancel.h"
 #include "glint/factories/scene_loader.h"
 #include "glint/job/job_error.h"
+#include "glint/job/output_paths.h"
 #include "glint/writers/yaml_scene_writer.h"
 
 namespace glint {
@@ -34,26 +34,11 @@ std::string lowercase(std::string text) {
 }
 
 // Refuses, as a bad argument (exit status 2), a name the conversion cannot write a file under
-// (the output scene, checked before the scene is read, or a PLY file): a folder, a missing folder,
-// a name too long for the file system.
+// (the output scene, checked before the scene is read, or a PLY file): output_paths' reasons.
 void checkTarget(const fs::path& target) {
-  std::error_code error;
-  if (fs::is_directory(target, error)) {
+  if (const std::string problem = targetProblem(target); !problem.empty()) {
     throw JobError(JobFailure::BadInput,
-                   fmt::format("{}: cannot write: it is a folder", target.string()));
-  }
-  fs::path folder = target.parent_path();
-  if (folder.empty()) folder = ".";
-  if (!fs::is_directory(folder, error)) {
-    throw JobError(JobFailure::BadInput, fmt::format("{}: the folder {} does not exist",
-                                                     target.string(), folder.string()));
-  }
-  const long nameMax = ::pathconf(folder.c_str(), _PC_NAME_MAX);
-  if (nameMax > 0 && target.filename().string().size() > static_cast<std::size_t>(nameMax)) {
-    throw JobError(JobFailure::BadInput,
-                   fmt::format("{}: cannot write: the file name is {} bytes long, longer than the "
-                               "{} its folder allows",
-                               target.string(), target.filename().string().size(), nameMax));
+                   fmt::format("{}: cannot write: {}", target.string(), problem));
   }
 }
 
@@ -67,7 +52,7 @@ void checkOutput(const fs::path& output, const fs::path& scene) {
   }
   checkTarget(output);
   std::error_code error;
-  if (fs::exists(output, error) && fs::equivalent(output, scene, error)) {
+  if (fs::exists(output, error) && sameFile(output, scene)) {
     throw JobError(JobFailure::BadInput,
                    fmt::format("{}: the output is the scene being converted; choose another name",
                                output.string()));
@@ -76,12 +61,8 @@ void checkOutput(const fs::path& output, const fs::path& scene) {
 
 // Whether `target` is one of the files the scene reads (by name, or the same file by another).
 bool readByScene(const fs::path& target, const std::vector<fs::path>& inputs) {
-  const fs::path absolute = fs::absolute(target).lexically_normal();
-  std::error_code error;
-  for (const fs::path& input : inputs) {
-    if (input == absolute || fs::equivalent(input, target, error)) return true;
-  }
-  return false;
+  return std::any_of(inputs.begin(), inputs.end(),
+                     [&](const fs::path& input) { return sameFile(target, input); });
 }
 
 // Writes every file (the meshes, then the scene) or none: each is written whole to a temporary
