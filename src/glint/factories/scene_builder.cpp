@@ -599,6 +599,23 @@ class Builder {
                                 named, file->droppedTriangles,
                                 file->droppedTriangles == 1 ? "" : "s", triangles));
     }
+    if (file->exactPositionNormalParts > 0) {
+      sink_.warning(
+          params.location(),
+          fmt::format("{}: its generated normals smooth only over vertices at exactly the "
+                      "same position: within the usual radius (1e-4 of the bounding "
+                      "box's diagonal) too many vertices are near one another — is "
+                      "there a vertex far from the rest?",
+                      named));
+    }
+    if (file->crowdedNormalPositions > 0) {
+      sink_.warning(params.location(),
+                    fmt::format("{}: in its generated normals, at {} position{} shared by more "
+                                "than {} triangle corners each corner keeps its own triangle's "
+                                "normal",
+                                named, file->crowdedNormalPositions,
+                                file->crowdedNormalPositions == 1 ? "" : "s", kMaxSmoothedCorners));
+    }
     if (!file->ignoredTextures.empty()) {
       std::vector<std::string> ignoredShown;
       for (const std::string& ignored : file->ignoredTextures) {

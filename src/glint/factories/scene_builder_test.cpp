@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <string>
 #include <variant>
 #include <vector>
@@ -22,6 +23,7 @@
 #include "glint/factories/scene_loader.h"
 #include "glint/factories/scene_test_support.h"
 #include "glint/geometry/csg.h"
+#include "glint/mesh/mesh_file.h"
 #include "glint/readers/yaml_scene_reader.h"
 #include "glint/scene/scene.h"
 #include "glint/scene/scene_limits.h"
@@ -980,6 +982,57 @@ TEST(SceneBuilder, MeshDegenerateTrianglesAreOneWarningAtTheObject) {
             "(zero area, non-finite or invalid vertices); 1 remain");
   ASSERT_EQ(loaded.parts.meshes.size(), 1u);
   EXPECT_EQ(loaded.parts.meshes[0].triangleCount(), 1u);
+}
+
+// Generated normals that leave their definition to stay fast (generateSmoothNormals: a far
+// outlier vertex, a position shared by too many corners) say so at the object.
+TEST(SceneBuilder, MeshGeneratedNormalsThatGiveUpSmoothingAreWarnings) {
+  MeshDir dir;
+  std::string grid;  // 40 × 40 quads and one triangle a million units away
+  for (int i = 0; i <= 40; ++i) {
+    for (int j = 0; j <= 40; ++j) grid += fmt::format("v {} {} {}\n", i / 40.0, 0, j / 40.0);
+  }
+  for (int i = 0; i < 40; ++i) {
+    for (int j = 0; j < 40; ++j) {
+      const int a = i * 41 + j + 1;
+      grid += fmt::format("f {} {} {} {}\n", a, a + 1, a + 42, a + 41);
+    }
+  }
+  grid += "v 1e6 0 0\nv 1e6 0 1\nv 1e6 1 0\nf 1682 1683 1684\n";
+  dir.write("outlier.obj", grid);
+  std::string fan = "v 0 1 0\n";  // kMaxSmoothedCorners + 1 triangles around one vertex
+  const std::uint32_t triangles = kMaxSmoothedCorners + 1;
+  for (std::uint32_t k = 0; k < triangles; ++k) {
+    const double angle = 2 * std::numbers::pi * k / triangles;
+    fan += fmt::format("v {} 0 {}\n", std::cos(angle), std::sin(angle));
+  }
+  for (std::uint32_t k = 0; k < triangles; ++k) {
+    fan += fmt::format("f 1 {} {}\n", (k + 1) % triangles + 2, k + 2);
+  }
+  dir.write("fan.obj", fan);
+  const LoadedScene loaded = loadIn(dir, std::string(kMinimal) + kLit +
+                                             "objects:\n"
+                                             "  - {type: mesh, file: outlier.obj}\n"
+                                             "  - {type: mesh, file: fan.obj}\n");
+  ASSERT_EQ(loaded.warnings.size(), 2u);
+  EXPECT_EQ(loaded.warnings[0].format(),
+            "meshes.yaml:5:5: warning: mesh file 'outlier.obj': its generated normals smooth only "
+            "over vertices at exactly the same position: within the usual radius (1e-4 of the "
+            "bounding box's diagonal) too many vertices are near one another — is there a vertex "
+            "far from the rest?");
+  EXPECT_EQ(loaded.warnings[1].format(),
+            "meshes.yaml:6:5: warning: mesh file 'fan.obj': in its generated normals, at 1 "
+            "position shared by more than 1024 triangle corners each corner keeps its own "
+            "triangle's normal");
+  ASSERT_EQ(loaded.parts.meshes.size(), 2u);
+  // The grid is flat: its normals are straight up (or down) whichever way they were smoothed.
+  const TriangleMesh& flat = loaded.parts.meshes[0];
+  ASSERT_EQ(flat.normals.size(), flat.positions.size());
+  for (std::size_t v = 0; v < flat.positions.size(); ++v) {
+    if (flat.positions[v].x < 2) {
+      EXPECT_NEAR(std::abs(flat.normals[v].y), 1, 1e-6) << v;
+    }
+  }
 }
 
 TEST(SceneBuilder, MeshFilesThatCannotBeLoadedAreErrorsAtTheObject) {

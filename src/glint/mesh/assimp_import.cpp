@@ -486,7 +486,9 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
       aiMesh* mesh = scene->mMeshes[m];
       if (mesh->mNormals == nullptr &&
           (mesh->mPrimitiveTypes & (aiPrimitiveType_TRIANGLE | aiPrimitiveType_POLYGON)) != 0) {
-        generateSmoothNormals(*mesh, kMeshCreaseAngleDegrees);
+        const SmoothNormalsReport smoothed = generateSmoothNormals(*mesh, kMeshCreaseAngleDegrees);
+        if (smoothed.exactPositionsOnly) ++result.exactPositionNormalParts;
+        result.crowdedNormalPositions += smoothed.crowdedPositions;
       }
     }
 

@@ -38,6 +38,9 @@ inline constexpr std::uint32_t kMaxFaceCorners = 16384;
 // within this angle of the corner's own triangle. Edges sharper than it — a box's 90° edges — stay
 // hard; the smooth surfaces of a finely divided model get one normal per vertex.
 inline constexpr double kMeshCreaseAngleDegrees = 80;
+// Corners at one position beyond which generated normals stop comparing them pairwise (see
+// generateSmoothNormals): each keeps its own triangle's normal.
+inline constexpr std::uint32_t kMaxSmoothedCorners = 1024;
 
 // Bytes of one copy of a mesh's arrays (TriangleMesh, double precision): 24 B per position and
 // 24 B per normal, 12 B of indices per triangle.
@@ -134,6 +137,12 @@ struct MeshFile {
   // Textures the materials name that glint does not use, as "map_Ka 'wood.png'" (an OBJ's
   // ambient, opacity, shininess, reflection and displacement maps): reported in a warning.
   std::vector<std::string> ignoredTextures;  // at most kMaxIgnoredTextures
+  // Of the parts whose normals glint generated (generateSmoothNormals, mesh_repair.h): those whose
+  // vertices are smoothed with the vertices at exactly their position only (their smoothing radius
+  // reached too many: a far outlier), and the positions whose corners kept their own faces'
+  // normals (more than kMaxSmoothedCorners corners). Reported in warnings.
+  std::size_t exactPositionNormalParts = 0;
+  std::size_t crowdedNormalPositions = 0;
 
   std::size_t triangleCount() const;
 };

@@ -26,6 +26,8 @@ namespace wire {
 
 bool writeMeshFile(int fd, const MeshFile& file) {
   bool ok = writeValue(fd, 'M') && writeValue(fd, std::uint64_t{file.droppedTriangles}) &&
+            writeValue(fd, std::uint64_t{file.exactPositionNormalParts}) &&
+            writeValue(fd, std::uint64_t{file.crowdedNormalPositions}) &&
             writeValue(fd, std::uint64_t{file.ignoredTextures.size()});
   for (const std::string& ignored : file.ignoredTextures) {
     ok = ok && writeMessage(fd, 'I', ignored);

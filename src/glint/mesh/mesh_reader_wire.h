@@ -17,7 +17,7 @@
 namespace glint::wire {
 
 // The first argument of the reader program: a reader from another glint build refuses to answer.
-inline constexpr const char* kMeshReaderProtocol = "glint-mesh-reader/" GLINT_VERSION "/2";
+inline constexpr const char* kMeshReaderProtocol = "glint-mesh-reader/" GLINT_VERSION "/3";
 
 // Writes everything or stops silently (the parent sees a short message).
 inline bool writeAll(int fd, const void* data, std::size_t size) {

@@ -489,9 +489,10 @@ bool samePosition(const aiVector3D& a, const aiVector3D& b) {
 
 }  // namespace
 
-void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
+SmoothNormalsReport generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
+  SmoothNormalsReport report;
   const std::size_t n = mesh.mNumVertices;
-  if (n == 0 || mesh.mVertices == nullptr) return;
+  if (n == 0 || mesh.mVertices == nullptr) return report;
   const aiVector3D* vertices = mesh.mVertices;
   constexpr std::uint32_t kNone = 0xffffffffu;
   // Each face's unit normal, and each vertex's face: the last one that uses it.
@@ -599,10 +600,13 @@ void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
   }
   const double squaredEpsilon = epsilon * epsilon;
   std::vector<std::uint32_t> near;
-  const auto findNear = [&](std::size_t p) {
+  // Work done (positions looked at, pairs of vertices compared), against the budget of a search
+  // within epsilon.
+  std::uint64_t work = 0;
+  const auto findNear = [&](std::size_t p, bool withinEpsilon) {
     near.clear();
     const Double3 q = toDouble(vertices[firstVertex[p]]);
-    if (!grid || !isFinite(q)) {
+    if (!withinEpsilon || !isFinite(q)) {
       near.push_back(static_cast<std::uint32_t>(p));
       return;
     }
@@ -622,6 +626,7 @@ void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
           auto it = std::lower_bound(byCell.begin(), byCell.end(),
                                      std::pair<std::uint64_t, std::uint32_t>{key, 0});
           for (; it != byCell.end() && it->first == key; ++it) {
+            ++work;
             const std::uint32_t other = it->second;
             const Double3 r = toDouble(vertices[firstVertex[other]]);
             const double dx = r.x - q.x, dy = r.y - q.y, dz = r.z - q.z;
@@ -632,11 +637,16 @@ void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
     }
   };
 
-  // Each vertex: the sum of the face normals within the crease angle at positions within epsilon.
+  // Each vertex: the sum of the face normals within the crease angle at positions within epsilon
+  // (withinEpsilon), or at its own position only. Comparing every pair of vertices near each other
+  // is quadratic where many are near: the search within epsilon gives up past its budget (false),
+  // and the vertices at a position of more than kMaxSmoothedCorners keep their own face's normal.
   const double cosLimit = std::cos(creaseDegrees * std::numbers::pi / 180);
   if (mesh.mNormals == nullptr) mesh.mNormals = new aiVector3D[n];
-  for (std::size_t p = 0; p < positions; ++p) {
-    findNear(p);
+  const std::uint64_t budget = std::uint64_t{kMaxSmoothedCorners} * n + (std::uint64_t{1} << 24);
+  // The normals of the vertices at position p from the positions in `near`; `crowded`: each its
+  // own face's.
+  const auto smoothPosition = [&](std::size_t p, bool crowded) {
     for (std::uint32_t i = rowStart[p]; i < rowStart[p + 1]; ++i) {
       const std::uint32_t v = verticesAt[i];
       if (faceOf[v] == kNone) {
@@ -644,8 +654,9 @@ void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
         continue;
       }
       const Double3 own = faceNormal[faceOf[v]];
-      Double3 sum;
-      for (const std::uint32_t other : near) {
+      Double3 sum = crowded ? own : Double3{};
+      for (std::size_t k = 0; !crowded && k < near.size(); ++k) {
+        const std::uint32_t other = near[k];
         for (std::uint32_t j = rowStart[other]; j < rowStart[other + 1]; ++j) {
           const std::uint32_t w = verticesAt[j];
           if (faceOf[w] == kNone) continue;
@@ -662,7 +673,31 @@ void generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
           aiVector3D(static_cast<float>(sum.x * scale), static_cast<float>(sum.y * scale),
                      static_cast<float>(sum.z * scale));
     }
+  };
+  const auto smooth = [&](bool withinEpsilon) {
+    work = 0;
+    report.crowdedPositions = 0;
+    for (std::size_t p = 0; p < positions; ++p) {
+      findNear(p, withinEpsilon);
+      const std::uint32_t corners = rowStart[p + 1] - rowStart[p];
+      const bool crowded = corners > kMaxSmoothedCorners;
+      if (crowded) {
+        ++report.crowdedPositions;
+      } else if (withinEpsilon) {
+        for (const std::uint32_t other : near) {
+          work += std::uint64_t{corners} * (rowStart[other + 1] - rowStart[other]);
+        }
+      }
+      if (withinEpsilon && work > budget) return false;
+      smoothPosition(p, crowded);
+    }
+    return true;
+  };
+  if (!smooth(grid)) {
+    report.exactPositionsOnly = true;
+    smooth(false);
   }
+  return report;
 }
 
 }  // namespace glint

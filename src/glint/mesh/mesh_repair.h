@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "glint/geometry/triangle_mesh.h"
+#include "glint/mesh/mesh_file.h"
 
 struct aiMesh;
 struct aiScene;
@@ -37,14 +38,27 @@ void splitSharedCorners(aiScene& scene);
 
 // Vertex normals for a mesh without them (after splitSharedCorners and assimp's triangulation), as
 // assimp's GenSmoothNormals step defines them but in O(n) instead of its spatial sort's O(n^1.5)
-// (7.5 s of a 1M-triangle file's load; both are quadratic when epsilon spans most positions, as
-// one far outlier makes it): each vertex first takes the unit normal of the last face
+// (7.5 s of a 1M-triangle file's load): each vertex first takes the unit normal of the last face
 // that uses it (p1 − p0) × (p_last − p0); then its normal is the normalised sum of those normals
 // over the vertices within epsilon of its position (1e-4 of the mesh's bounding-box diagonal)
 // whose normal lies within `creaseDegrees` of its own (itself always). Vertices within epsilon are
 // found through a grid of cells 16 epsilon wide over the distinct positions. Computed in double
 // precision, stored as floats; a vertex of no face gets NaN (convertMesh rebuilds it or drops it).
-void generateSmoothNormals(aiMesh& mesh, double creaseDegrees);
+//
+// Comparing the vertices near each other pairwise is quadratic where many are near one another,
+// so two limits keep hostile or broken files from taking hours (a 200k-triangle fan took 41 s):
+// when epsilon reaches most of the model (one far outlier makes it so) and the comparisons pass a
+// budget of kMaxSmoothedCorners per vertex, the search starts over with the vertices at exactly
+// the same position only (SmoothNormalsReport::exactPositionsOnly); and the vertices at a position
+// shared by more than kMaxSmoothedCorners corners (the apex of a huge fan) keep their own face's
+// normal (crowdedPositions). Real models stay far below both (a UV sphere of 1024 segments has
+// 1024 corners at a pole), so their normals follow the definition.
+// (kMaxSmoothedCorners: mesh_file.h)
+struct SmoothNormalsReport {
+  bool exactPositionsOnly = false;
+  std::size_t crowdedPositions = 0;
+};
+SmoothNormalsReport generateSmoothNormals(aiMesh& mesh, double creaseDegrees);
 
 // Faces of at least three corners in all meshes of the scene.
 std::size_t facesWithTriangles(const aiScene& scene);

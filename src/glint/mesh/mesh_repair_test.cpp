@@ -227,6 +227,142 @@ TEST(MeshRepair, GeneratedNormalsFollowTheirDefinition) {
   EXPECT_GT(merged, 0);  // some moved corners were within epsilon of others
 }
 
+// An assimp mesh of one vertex per corner, three corners per triangle (as assimp's OBJ importer
+// gives), positions rounded to float as assimp stores them.
+void setCorners(aiMesh& mesh, const std::vector<Point3>& corners) {
+  mesh.mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  mesh.mNumVertices = static_cast<unsigned>(corners.size());
+  mesh.mVertices = new aiVector3D[corners.size()];
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    mesh.mVertices[i] =
+        aiVector3D(static_cast<float>(corners[i].x), static_cast<float>(corners[i].y),
+                   static_cast<float>(corners[i].z));
+  }
+  mesh.mNumFaces = mesh.mNumVertices / 3;
+  mesh.mFaces = new aiFace[mesh.mNumFaces];
+  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+    mesh.mFaces[f].mNumIndices = 3;
+    mesh.mFaces[f].mIndices = new unsigned[3]{3 * f, 3 * f + 1, 3 * f + 2};
+  }
+}
+
+// The unit normal of the triangle of corner i (zero for one of no area), from the float positions.
+Vec3 cornerFaceNormal(const aiMesh& mesh, std::size_t i) {
+  const auto at = [&](std::size_t k) {
+    const aiVector3D& v = mesh.mVertices[k];
+    return Point3{v.x, v.y, v.z};
+  };
+  const std::size_t f = i / 3;
+  const Vec3 n = cross(at(3 * f + 1) - at(3 * f), at(3 * f + 2) - at(3 * f));
+  const double length = std::sqrt(dot(n, n));
+  return length > 0 ? n / length : n;
+}
+
+// Checks the normals of the corners `which` against the smoothing over exactly equal positions:
+// the normalised sum of the face normals, within the crease angle, of the corners at exactly
+// corner i's position (itself always).
+void expectSmoothedOverExactPositions(const aiMesh& mesh, const std::vector<std::size_t>& which) {
+  std::map<std::tuple<float, float, float>, std::vector<std::size_t>> cornersAt;
+  for (std::size_t i = 0; i < mesh.mNumVertices; ++i) {
+    const aiVector3D& v = mesh.mVertices[i];
+    cornersAt[{v.x, v.y, v.z}].push_back(i);
+  }
+  const double cosLimit = std::cos(kMeshCreaseAngleDegrees * std::numbers::pi / 180);
+  for (const std::size_t i : which) {
+    const aiVector3D& v = mesh.mVertices[i];
+    Vec3 sum;
+    for (const std::size_t j : cornersAt[{v.x, v.y, v.z}]) {
+      if (j != i && !(dot(cornerFaceNormal(mesh, j), cornerFaceNormal(mesh, i)) >= cosLimit)) {
+        continue;
+      }
+      sum = sum + cornerFaceNormal(mesh, j);
+    }
+    const Vec3 expected = sum / std::sqrt(dot(sum, sum));
+    const aiVector3D& got = mesh.mNormals[i];
+    ASSERT_NEAR(got.x, expected.x, 1e-6) << i;
+    ASSERT_NEAR(got.y, expected.y, 1e-6) << i;
+    ASSERT_NEAR(got.z, expected.z, 1e-6) << i;
+  }
+}
+
+// One vertex far from a model makes epsilon (1e-4 of the bounding box's diagonal) reach across the
+// whole model, and the pairwise comparisons quadratic (a 150 × 150 grid took 11 s, a larger one
+// hours): past the budget the normals smooth over exactly shared positions only, and say so.
+TEST(MeshRepair, GeneratedNormalsWithAFarOutlierSmoothOverExactPositions) {
+  constexpr int kCells = 100;
+  const auto height = [](int i, int j) { return 0.02 * std::sin(0.7 * i) * std::cos(0.9 * j); };
+  const auto point = [&](int i, int j) {
+    return Point3{static_cast<double>(i) / kCells, height(i, j), static_cast<double>(j) / kCells};
+  };
+  std::vector<Point3> corners;
+  for (int i = 0; i < kCells; ++i) {
+    for (int j = 0; j < kCells; ++j) {
+      const Point3 a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1),
+                   d = point(i, j + 1);
+      for (const Point3& p : {a, c, b, a, d, c}) corners.push_back(p);
+    }
+  }
+  for (const Point3& p : {Point3{1e6, 0, 0}, Point3{1e6, 0, 1}, Point3{1e6, 1, 0}}) {
+    corners.push_back(p);
+  }
+  aiMesh mesh;
+  setCorners(mesh, corners);
+  const SmoothNormalsReport report = generateSmoothNormals(mesh, kMeshCreaseAngleDegrees);
+  EXPECT_TRUE(report.exactPositionsOnly);
+  EXPECT_EQ(report.crowdedPositions, 0u);
+  std::vector<std::size_t> all(corners.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  expectSmoothedOverExactPositions(mesh, all);
+  // A grid vertex inside averages its six triangles: not any one face's normal.
+  const std::size_t inner = 6 * (50 * kCells + 50);  // corner a of cell (50, 50)
+  EXPECT_GT(
+      std::abs(dot(cornerFaceNormal(mesh, inner),
+                   Vec3{mesh.mNormals[inner].x, mesh.mNormals[inner].y, mesh.mNormals[inner].z}) -
+               1),
+      1e-9);
+}
+
+// A position shared by more corners than kMaxSmoothedCorners (the apex of a huge fan: 200,000
+// triangles took 41 s) leaves its corners their own faces' normals; one of exactly that many (the
+// pole of a fine UV sphere) is smoothed as always, and the other positions are too.
+TEST(MeshRepair, GeneratedNormalsAtACrowdedPositionKeepTheirFaceNormals) {
+  for (const std::uint32_t triangles : {kMaxSmoothedCorners, kMaxSmoothedCorners + 1}) {
+    SCOPED_TRACE(triangles);
+    const auto rim = [&](std::uint32_t k) {
+      const double angle = 2 * std::numbers::pi * k / triangles;
+      return Point3{std::cos(angle), 0.2 * std::sin(5 * angle), std::sin(angle)};
+    };
+    std::vector<Point3> corners;
+    for (std::uint32_t k = 0; k < triangles; ++k) {
+      for (const Point3& p : {Point3{0, 0.5, 0}, rim((k + 1) % triangles), rim(k)}) {
+        corners.push_back(p);
+      }
+    }
+    aiMesh mesh;
+    setCorners(mesh, corners);
+    const SmoothNormalsReport report = generateSmoothNormals(mesh, kMeshCreaseAngleDegrees);
+    EXPECT_FALSE(report.exactPositionsOnly);
+    const bool crowded = triangles > kMaxSmoothedCorners;
+    EXPECT_EQ(report.crowdedPositions, crowded ? 1u : 0u);
+    std::vector<std::size_t> apex;
+    std::vector<std::size_t> others;
+    for (std::size_t i = 0; i < corners.size(); ++i) (i % 3 == 0 ? apex : others).push_back(i);
+    // The rim's points are ~2π/1024 apart, far beyond epsilon (1e-4 of a diagonal of ~2.9): their
+    // smoothing is over exactly shared positions.
+    expectSmoothedOverExactPositions(mesh, others);
+    if (!crowded) {
+      expectSmoothedOverExactPositions(mesh, apex);
+      continue;
+    }
+    for (const std::size_t i : apex) {
+      const Vec3 own = cornerFaceNormal(mesh, i);
+      ASSERT_NEAR(mesh.mNormals[i].x, own.x, 1e-6) << i;
+      ASSERT_NEAR(mesh.mNormals[i].y, own.y, 1e-6) << i;
+      ASSERT_NEAR(mesh.mNormals[i].z, own.z, 1e-6) << i;
+    }
+  }
+}
+
 TEST(MeshRepair, IndexedFilesWithoutNormalsGetSmoothNormalsPerVertex) {
   // The same icosahedron, but indexed (PLY shares each vertex among its five faces): the generated
   // normal of a vertex must still average all five faces (the vertex direction), not keep the
