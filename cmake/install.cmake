@@ -27,6 +27,9 @@ install(TARGETS glint EXPORT glintTargets
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/glint/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/glint
         COMPONENT dev FILES_MATCHING PATTERN "*.h"
         PATTERN "*_test_support.h" EXCLUDE PATTERN "cli" EXCLUDE
+        # The mesh reader's side of the import (glint_mesh_import, not in libglint).
+        PATTERN "assimp_import.h" EXCLUDE PATTERN "obj_fast_parse.h" EXCLUDE
+        PATTERN "mesh_reader_side.h" EXCLUDE PATTERN "mesh_reader_wire.h" EXCLUDE
         PATTERN "cluster" EXCLUDE)  # built only with MPI, into the command alone
 install(FILES ${PROJECT_BINARY_DIR}/include/glint/core/version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/glint/core COMPONENT dev)
@@ -76,5 +79,5 @@ find_package(glint CONFIG) gives the target glint::glint.")
 # What glintConfig.cmake finds (find_dependency, pkg-config), as Debian packages.
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
     "glint (= ${PROJECT_VERSION}), cmake, pkg-config, libtbb-dev, libfmt-dev, libpng-dev, \
-libjpeg62-turbo-dev, libassimp-dev, libyaml-dev")
+libjpeg62-turbo-dev, libyaml-dev")
 include(CPack)

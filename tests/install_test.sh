@@ -65,6 +65,16 @@ cmake --build "$work/examples" -j "${GLINT_JOBS:-2}" --target seed_test_case ren
 cmp "$work/seed.png" "$work/seed-in-tree.png" ||
   fail "the example built against the installed package renders other bytes than the in-tree one"
 echo "ok: examples/ built against the installed glint renders the seed's test case"
+# Only the mesh reader runs assimp: the package's consumers neither find nor link it (no
+# libassimp-dev needed to build against libglint), and no installed header declares its side.
+! grep -rl 'assimp' "$(dirname "$config")" || fail "glint's CMake package names assimp"
+if command -v ldd >/dev/null; then
+  ! ldd "$work/examples/render_scene_file" | grep -q libassimp ||
+    fail "a program linked with the installed library links libassimp"
+fi
+for internal in assimp_import.h obj_fast_parse.h mesh_reader_side.h mesh_reader_wire.h; do
+  [[ ! -e "$prefix/include/glint/mesh/$internal" ]] || fail "mesh/$internal was installed"
+done
 
 # A program of the library's user, in PREFIX/bin: a mesh scene (the installed mesh reader) to an
 # EXR image (the installed module), found from the program's place — never from the build tree,

@@ -39,10 +39,6 @@ MeshFile importMeshInChild(const std::filesystem::path& path, const std::string&
 // The name of the mesh reader program.
 inline constexpr const char* kMeshReaderProgram = "glint-mesh-reader";
 
-// The mesh reader program's main: the child's side of importMeshInChild (its arguments are
-// importMeshInChild's; run alone it says so and returns 2).
-int runMeshReader(int argc, char** argv);
-
 // For tests of the parent's waiting (cancellation, time limit): every child started from now on
 // sleeps `delay` before it reads the file; zero turns it off.
 void setImportChildDelayForTesting(std::chrono::milliseconds delay);

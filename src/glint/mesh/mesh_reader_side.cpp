@@ -1,6 +1,9 @@
 // The mesh reader program's side of the import in a child process (import_child.h): reads one
-// file with importMesh (assimp, or glint's own OBJ parse) and writes the answer. Its own
-// translation unit so that the renderer, which only starts the reader, does not link assimp.
+// file with importMesh (assimp, or glint's own OBJ parse) and writes the answer. In
+// glint_mesh_import with the other sources that link assimp, so that the renderer and libglint,
+// which only start the reader, do not.
+#include "glint/mesh/mesh_reader_side.h"
+
 #include <malloc.h>
 #include <sys/resource.h>
 #include <unistd.h>
