@@ -31,6 +31,11 @@ ValueId findKey(const ValueTree& tree, ValueId map, std::string_view key) {
   return kNoValue;
 }
 
+// How deep `include`s may nest (the scene file's own includes are depth 1). Each level reads its
+// file on the stack of the one that includes it: a chain of thousands of files exhausted the stack
+// (a crash); POV-Ray allows 10 levels, 64 leaves room for any library layout.
+constexpr std::size_t kMaxIncludeDepth = 64;
+
 // The files being read through `include`, outermost first (to find cycles), and the cancel flag.
 struct IncludeState {
   std::vector<std::filesystem::path> open;  // weakly canonical paths
@@ -183,6 +188,15 @@ class TopLevel {
     const fs::path path = fs::path(written).is_relative()
                               ? (source_.baseDirectory / written).lexically_normal()
                               : fs::path(written);
+    // open holds the scene file and each file whose includes are being read.
+    if (includes_.open.size() > kMaxIncludeDepth) {
+      reader_.error(place,
+                    fmt::format("cannot include '{}': includes nest more than {} files "
+                                "deep (from {})",
+                                escapeForMessage(written), kMaxIncludeDepth,
+                                escapeForMessage(includes_.open.front().filename().string())));
+      return;
+    }
     std::error_code ignored;
     const fs::path identity = fs::weakly_canonical(path, ignored);
     for (std::size_t i = 0; i < includes_.open.size(); ++i) {

@@ -902,6 +902,30 @@ TEST_F(IncludeFiles, AFileReachedTwiceIsIncludedOnce) {
                                       "twice (first at common/palette.yaml:4:3)"}));
 }
 
+// A chain of includes reads each file on the stack of the one before: thousands of files crashed
+// glint (stack exhaustion). 64 levels are read; the 65th is an error at the include that asks for
+// it, and the files above it still count.
+TEST_F(IncludeFiles, IncludesNestAtMost64Deep) {
+  const auto chain = [&](const std::string& prefix, int files) {
+    write(prefix + "scene.yaml", "include: " + prefix + "0.yaml\n" + kCameraImage +
+                                     "objects:\n  - {type: sphere, center: [0, 0, 0], radius: "
+                                     "1, material: m0}\n");
+    for (int i = 0; i < files; ++i) {
+      const std::string next =
+          i + 1 < files ? "include: " + prefix + std::to_string(i + 1) + ".yaml\n" : "";
+      write(prefix + std::to_string(i) + ".yaml",
+            next + "materials: {m" + std::to_string(i) + ": {kd: 0.5}}\n");
+    }
+  };
+  chain("ok", 64);
+  EXPECT_TRUE(errorsOf("okscene.yaml").empty());
+  EXPECT_EQ(loadScene(dir_ / "okscene.yaml").parts.materials.size(), 65u);  // and the default
+  chain("deep", 6000);
+  EXPECT_EQ(errorsOf("deepscene.yaml"),
+            (std::vector<std::string>{"deep63.yaml:1:10: cannot include 'deep64.yaml': includes "
+                                      "nest more than 64 files deep (from deepscene.yaml)"}));
+}
+
 TEST_F(IncludeFiles, CyclesMissingFilesAndSceneKeysAreErrorsAtTheirPlace) {
   write("a.yaml", std::string("include: [b.yaml, missing.yaml]\n") + kCameraImage);
   write("b.yaml", "include: [a.yaml]\nmaterials: {m: {kd: 1}}\nobjects: []\n");
