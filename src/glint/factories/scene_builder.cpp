@@ -187,15 +187,10 @@ class Builder {
               emission != materialEmission_.end() ? std::optional<Color>(emission->second)
                                                   : std::nullopt};
     }
-    std::vector<std::string> names;
-    for (const auto& [n, index] : materialIndex_) names.push_back(n);
-    std::string hint = didYouMean(name, names);
-    if (hint.empty()) {
-      hint = names.empty() ? "; no materials are defined"
-                           : fmt::format("; defined: {}", fmt::join(names, ", "));
-    }
+    const std::string hint =
+        undefinedNameHint(name, materialIndex_, "; no materials are defined", materialHintsLeft_);
     params.error(entry->where, fmt::format("{}.material: undefined material '{}'{}", owner,
-                                           escapeForMessage(name), hint));
+                                           nameForMessage(name), hint));
     return {0, true, std::nullopt};
   }
 
@@ -308,15 +303,10 @@ class Builder {
     if (!group) return;
     const auto it = groupIndex_.find(group->value);
     if (it == groupIndex_.end()) {
-      std::vector<std::string> names;
-      for (const auto& [n, index] : groupIndex_) names.push_back(n);
-      std::string hint = didYouMean(group->value, names);
-      if (hint.empty()) {
-        hint = names.empty() ? "; no groups are defined"
-                             : fmt::format("; defined: {}", fmt::join(names, ", "));
-      }
+      const std::string hint =
+          undefinedNameHint(group->value, groupIndex_, "; no groups are defined", groupHintsLeft_);
       params.error(group->where, fmt::format("instance.group: undefined group '{}'{}",
-                                             escapeForMessage(group->value), hint));
+                                             nameForMessage(group->value), hint));
       return;
     }
     if (params.errors() != 0 || !transform.ok) return;
@@ -921,7 +911,10 @@ class Builder {
   const ObjectFactory csgFactory_{"csg", kCsgKeys, nullptr};
   std::map<std::uint32_t, std::pair<std::uint32_t, TextPosition>> materialWhere_;  // file, place
   std::map<std::uint32_t, Color> materialEmission_;  // named materials with an `emission`
-  std::map<std::string, std::uint32_t, std::less<>> groupIndex_;    // into parts_.groups
+  std::map<std::string, std::uint32_t, std::less<>> groupIndex_;  // into parts_.groups
+  // Undefined material and group names that may still get a hint (undefinedNameHint).
+  int materialHintsLeft_ = kMaxNameHints;
+  int groupHintsLeft_ = kMaxNameHints;
   std::vector<std::optional<Bounds3>> groupBounds_;                 // groupBounds()
   std::vector<std::pair<std::uint32_t, TextPosition>> groupWhere_;  // per group: file, place
   GroupParts* group_ = nullptr;  // while building a group's objects: where they go

@@ -512,6 +512,45 @@ TEST(SceneBuilder, UndefinedMaterialIsNamed) {
       4, 60, "undefined material 'steel'; no materials are defined");
 }
 
+// Names are the scene's text: the list of defined names in an undefined-name error is cut to ten
+// and escaped (a name of terminal escape codes printed them raw), a name past 256 bytes is an
+// error where it is defined, and an undefined one that long is shortened in the message (an alias
+// of a megabyte name, used at every object, kept a megabyte per error).
+TEST(SceneBuilder, NamesInErrorsAreFewShortAndEscaped) {
+  std::string materials = "materials:\n  \"red\\e[2J\": {kd: 1}\n";
+  for (int i = 0; i < 14; ++i) materials += fmt::format("  m{:02}: {{kd: 1}}\n", i);
+  expectOneError(std::string(kMinimal) + materials +
+                     "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: "
+                     "steel}\n",
+                 20, 60,
+                 "undefined material 'steel'; defined: m00, m01, m02, m03, m04, m05, m06, m07, "
+                 "m08, m09 and 5 more");
+  expectOneError(std::string(kMinimal) + materials +
+                     "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: "
+                     "red}\n",
+                 20, 60, "undefined material 'red'; defined: m00, m01");
+  expectOneError(std::string(kMinimal) + "materials:\n  \"red\\e[2J\": {kd: 1}\n" +
+                     "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, material: "
+                     "rod}\n",
+                 6, 60, "undefined material 'rod'; defined: red\\x1b[2J");
+  const std::string longName(300, 'n');
+  expectOneError(
+      std::string(kMinimal) + "materials:\n  " + longName + ": {kd: 1}\n", 4, 3,
+      "material name 'nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn...' is 300 bytes long, more "
+      "than the limit of 256");
+  const std::vector<Diagnostic> errors = errorsOf(
+      std::string(kMinimal) + "objects:\n  - {type: sphere, center: [0, 0, 0], radius: 1, " +
+      "material: " + longName + "}\n  - {type: instance, group: " + longName + "}\n");
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0].message,
+            "sphere.material: undefined material "
+            "'nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn...'; no materials are "
+            "defined");
+  EXPECT_EQ(errors[1].message,
+            "instance.group: undefined group "
+            "'nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn...'; no groups are defined");
+}
+
 // Points past ±1e100 are errors at the value; objects that sizes or transforms carry past it at
 // the object (the tests multiply up to three coordinates: beyond, a product overflows and the
 // object vanished from the image without a word).

@@ -143,15 +143,10 @@ std::optional<TextureId> TextureLibrary::read(ParameterDictionary& params, std::
   }
   const std::string_view name = tree.scalar(entry->value);
   if (const auto it = named_.find(name); it != named_.end()) return it->second;
-  std::vector<std::string> names;
-  for (const auto& [n, id] : named_) names.push_back(n);
-  std::string hint = didYouMean(name, names);
-  if (hint.empty()) {
-    hint = names.empty() ? "; no textures are defined (top-level 'textures')"
-                         : fmt::format("; defined: {}", fmt::join(names, ", "));
-  }
+  const std::string hint = undefinedNameHint(
+      name, named_, "; no textures are defined (top-level 'textures')", hintsLeft_);
   params.error(entry->where,
-               fmt::format("{}: undefined texture '{}'{}", path, escapeForMessage(name), hint));
+               fmt::format("{}: undefined texture '{}'{}", path, nameForMessage(name), hint));
   return std::nullopt;
 }
 

@@ -18,6 +18,7 @@
 #include "glint/factories/build_context.h"
 #include "glint/factories/texture_factories.h"
 #include "glint/readers/scene_description.h"
+#include "glint/readers/spelling.h"
 
 namespace glint {
 
@@ -88,6 +89,7 @@ class TextureLibrary : public ImageSource {
   std::function<double()> otherBytes_;
   // name → its texture, or nullopt when its definition was wrong (so uses are not reported again).
   std::map<std::string, std::optional<TextureId>, std::less<>> named_;
+  int hintsLeft_ = kMaxNameHints;  // undefined names that may still get a hint (undefinedNameHint)
   std::map<std::string, std::pair<std::uint32_t, TextPosition>, std::less<>>
       namedWhere_;  // file, place
   std::map<std::pair<std::string, ImageEncoding>, std::shared_ptr<const MipMap>> images_;

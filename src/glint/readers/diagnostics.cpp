@@ -67,6 +67,10 @@ std::string escaped(std::string_view text, std::size_t maxCharacters) {
 std::string shortenForMessage(std::string_view text) { return escaped(text, kMaxQuoted); }
 std::string escapeForMessage(std::string_view text) { return escaped(text, SIZE_MAX); }
 
+std::string nameForMessage(std::string_view name) {
+  return name.size() <= kMaxNameBytes ? escapeForMessage(name) : shortenForMessage(name);
+}
+
 std::string quoteForMessage(std::string_view text) { return "'" + shortenForMessage(text) + "'"; }
 
 bool hasErrors(const std::vector<Diagnostic>& diagnostics) {

@@ -36,6 +36,13 @@ inline constexpr std::size_t kMaxQuoted = 40;
 std::string shortenForMessage(std::string_view text);
 // The same escaping without the length limit: file and material names, shown whole.
 std::string escapeForMessage(std::string_view text);
+// Names of materials, textures and groups are at most this many bytes (longer ones are errors
+// where they are defined): one name is copied into every message about it and compared at every
+// use, so megabyte names made valid scenes take minutes and error lists gigabytes.
+inline constexpr std::size_t kMaxNameBytes = 256;
+// A name the scene uses, as messages show it: escaped, whole up to kMaxNameBytes (as it was
+// defined), shortened (shortenForMessage) past that.
+std::string nameForMessage(std::string_view name);
 std::string quoteForMessage(std::string_view text);
 
 // Bytes of the well-formed UTF-8 sequence starting at text[i] (1 for ASCII), or 0 when it is not

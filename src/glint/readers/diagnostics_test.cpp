@@ -1,9 +1,11 @@
 // How diagnostics quote what a file or the user wrote: file names and words with control bytes,
 // escape sequences and invalid UTF-8 written as escapes, never raw on the terminal.
 #include "glint/readers/diagnostics.h"
+#include "glint/readers/spelling.h"
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <string>
 
 namespace glint {
@@ -21,6 +23,26 @@ TEST(Diagnostics, QuotedWordsAreEscapedAndShortenedWithoutCuttingACharacter) {
   EXPECT_EQ(quoteForMessage("a\tb\nc\x7f"), "'a\\tb\\nc\\x7f'");
   const std::string long_word = std::string(39, 'a') + "é" + "zzz";
   EXPECT_EQ(quoteForMessage(long_word), "'" + std::string(39, 'a') + "é...'");
+}
+
+const std::string kLongName(100000, 'x');
+
+// Each hint reads every defined name: only the first kMaxNameHints undefined names of a kind get
+// one (thousands of undefined names among thousands of definitions took minutes), a candidate
+// whose length alone puts it too far costs no distance, and "no ... defined" is always said.
+TEST(Spelling, UndefinedNamesGetHintsWithinABudget) {
+  const std::map<std::string, int> names = {{"glass", 0}, {"steel", 1}, {kLongName, 2}};
+  int hintsLeft = kMaxNameHints;
+  for (int i = 0; i < kMaxNameHints; ++i) {
+    EXPECT_EQ(undefinedNameHint("glas", names, "; none", hintsLeft), " (did you mean 'glass'?)");
+  }
+  EXPECT_EQ(hintsLeft, 0);
+  EXPECT_EQ(undefinedNameHint("glas", names, "; none", hintsLeft), "");
+  EXPECT_EQ(undefinedNameHint("glas", std::map<std::string, int>(), "; none", hintsLeft), "; none");
+  hintsLeft = 1;
+  EXPECT_EQ(undefinedNameHint("wood", names, "; none", hintsLeft),
+            "; defined: glass, steel, " + std::string(40, 'x') + "...");
+  EXPECT_EQ(closestName(std::string(kLongName).substr(1), std::views::keys(names)), "");
 }
 
 }  // namespace

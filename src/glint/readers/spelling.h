@@ -4,9 +4,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cstddef>
+#include <ranges>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "glint/readers/diagnostics.h"
 
 namespace glint {
 
@@ -47,6 +50,11 @@ std::string closestName(std::string_view word, const Names& candidates) {
   for (const auto& candidate : candidates) {
     const std::string_view name(candidate);
     const std::size_t limit = std::min<std::size_t>(3, std::max(word.size(), name.size()) / 3);
+    // The distance is at least the difference in length: a candidate that far (every long one)
+    // costs no distance matrix.
+    const std::size_t lengths =
+        name.size() > word.size() ? name.size() - word.size() : word.size() - name.size();
+    if (lengths > std::max<std::size_t>(limit, 1)) continue;
     const std::size_t d = editDistance(word, name);
     if (word == name || d > std::max<std::size_t>(limit, 1)) continue;
     if (best.empty() || d < bestDistance) {
@@ -61,7 +69,37 @@ std::string closestName(std::string_view word, const Names& candidates) {
 template <class Names>
 std::string didYouMean(std::string_view word, const Names& candidates) {
   const std::string best = closestName(word, candidates);
-  return best.empty() ? std::string() : " (did you mean '" + best + "'?)";
+  return best.empty() ? std::string() : " (did you mean '" + shortenForMessage(best) + "'?)";
+}
+
+// The hint after "undefined material 'x'" (and texture, group): " (did you mean 'y'?)" when a
+// defined name is close, else "; defined: a, b, c" — at most kListedNames of them and how many
+// more, each as messages quote the scene's text (shortened, escaped) —, else `none` when nothing
+// is defined. Each hint reads every defined name, so only the first kMaxNameHints undefined names
+// of a kind get one (`hintsLeft` counts down; the loader prints 20 errors): a file of thousands
+// of undefined names among thousands of definitions took minutes.
+// `defined`: a map whose keys are the defined names.
+inline constexpr std::size_t kListedNames = 10;
+inline constexpr int kMaxNameHints = 20;
+template <class Map>
+std::string undefinedNameHint(std::string_view word, const Map& defined, std::string_view none,
+                              int& hintsLeft) {
+  if (defined.empty()) return std::string(none);
+  if (hintsLeft <= 0) return {};
+  --hintsLeft;
+  std::string hint = didYouMean(word, std::views::keys(defined));
+  if (!hint.empty()) return hint;
+  hint = "; defined: ";
+  std::size_t listed = 0;
+  for (const auto& entry : defined) {
+    if (listed == kListedNames) break;
+    if (listed++ > 0) hint += ", ";
+    hint += shortenForMessage(entry.first);
+  }
+  if (defined.size() > kListedNames) {
+    hint += " and " + std::to_string(defined.size() - kListedNames) + " more";
+  }
+  return hint;
 }
 
 }  // namespace glint

@@ -151,6 +151,12 @@ class TopLevel {
             key, fmt::format("expected a key name in {}, got {}", section, reader_.describe(key)));
         continue;
       }
+      if (const std::size_t bytes = tree().scalar(key).size(); bytes > kMaxNameBytes) {
+        reader_.error(key,
+                      fmt::format("{} name {} is {} bytes long, more than the limit of {}", what,
+                                  quoteForMessage(tree().scalar(key)), bytes, kMaxNameBytes));
+        continue;
+      }
       add(kind, static_cast<std::uint32_t>(i), tree().value(e->value, i), key, key);
     }
   }
