@@ -13,6 +13,7 @@
 #include <deque>
 #include <functional>
 #include <mutex>
+#include <set>
 #include <string>
 #include <system_error>
 #include <thread>
@@ -566,13 +567,15 @@ class Reader {
     const ValueTree& t = doc_.values;
     const std::vector<ValueId> children = t.openChildren();
     std::vector<ValueId> own, merged;
-    std::vector<std::string_view> present;
+    // The keys the mapping has so far: a sorted set (a list searched once per merged key was
+    // quadratic: 160,000 merged keys took 20 s; a hash set could be flooded by chosen keys).
+    std::set<std::string_view> present;
     const auto isMergeKey = [&](ValueId key) { return t.isScalar(key) && t.scalar(key) == "<<"; };
     for (std::size_t i = 0; i + 1 < children.size(); i += 2) {
       if (isMergeKey(children[i])) continue;
       own.push_back(children[i]);
       own.push_back(children[i + 1]);
-      if (t.isScalar(children[i])) present.push_back(t.scalar(children[i]));
+      if (t.isScalar(children[i])) present.insert(t.scalar(children[i]));
     }
     const auto mergeFrom = [&](ValueId map, ValueId where) {
       if (!t.isMap(map)) {
@@ -584,13 +587,9 @@ class Reader {
       for (std::size_t i = 0; i < t.size(map); ++i) {
         const ValueId key = t.key(map, i);
         if (isMergeKey(key)) continue;  // already resolved when that mapping closed
-        const std::string_view name = t.scalar(key);
-        if (t.isScalar(key) && std::find(present.begin(), present.end(), name) != present.end()) {
-          continue;
-        }
+        if (t.isScalar(key) && !present.insert(t.scalar(key)).second) continue;
         merged.push_back(key);
         merged.push_back(t.value(map, i));
-        if (t.isScalar(key)) present.push_back(name);
       }
     };
     for (std::size_t i = 0; i + 1 < children.size(); i += 2) {
