@@ -12,6 +12,7 @@
 #include <assimp/mesh.h>
 #include <assimp/scene.h>
 
+#include "glint/core/seeded_hash.h"
 #include "glint/mesh/mesh_file.h"
 #include "glint/mesh/obj_fast_parse.h"
 
@@ -83,10 +84,8 @@ struct VertexKey {
   float p[3];
   float n[3];
   float t[2];
-  bool operator==(const VertexKey& o) const {
-    return p[0] == o.p[0] && p[1] == o.p[1] && p[2] == o.p[2] && n[0] == o.n[0] && n[1] == o.n[1] &&
-           n[2] == o.n[2] && t[0] == o.t[0] && t[1] == o.t[1];
-  }
+  // The same bits (as hashOf reads them): −0 and 0 are two keys whatever the table's seed.
+  bool operator==(const VertexKey& o) const { return std::memcmp(this, &o, sizeof o) == 0; }
 };
 
 // `normal` and `texcoord` may be null (the mesh has none).
@@ -208,23 +207,17 @@ class SimpleObjVertices {
   mutable std::vector<FirstUse> firstUse_;  // per position index
 };
 
-std::uint64_t hashOf(const VertexKey& key) {
-  // FNV-1a over the eight floats' bits (positions are finite here: triangles touching a
-  // non-finite vertex were dropped), then a 64-bit finaliser (splitmix64) to spread them over the
-  // table.
-  std::uint64_t h = 1469598103934665603ull;
-  for (const auto& [f, count] : {std::pair{key.p, 3}, std::pair{key.n, 3}, std::pair{key.t, 2}}) {
-    for (int i = 0; i < count; ++i) {
-      std::uint32_t bits = 0;
-      std::memcpy(&bits, &f[i], sizeof bits);
-      h = (h ^ bits) * 1099511628211ull;
-    }
-  }
-  h ^= h >> 30;
-  h *= 0xbf58476d1ce4e5b9ull;
-  h ^= h >> 27;
-  h *= 0x94d049bb133111ebull;
-  return h ^ (h >> 31);
+// The eight floats' bits (positions are finite here: triangles touching a non-finite vertex were
+// dropped) folded in pairs through the process's seeded hash (core/seeded_hash.h): a file cannot
+// be made of vertices that all land in a few slots of the joining table.
+std::uint64_t hashOf(const VertexKey& key, std::uint64_t seed) {
+  std::uint32_t bits[8];
+  std::memcpy(bits, key.p, 12);
+  std::memcpy(bits + 3, key.n, 12);
+  std::memcpy(bits + 6, key.t, 8);
+  SeededHasher h(seed);
+  for (int i = 0; i < 8; i += 2) h.add(bits[i] | std::uint64_t{bits[i + 1]} << 32);
+  return h.value();
 }
 
 }  // namespace
@@ -332,6 +325,7 @@ JoinedMesh joinVertices(const Vertices& in, std::size_t& dropped) {
   // stays small enough for the cache. A slot holds the joined vertex in its low 32 bits and the
   // hash's high 32 bits above, which rule out almost every other key without reading it.
   constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+  const std::uint64_t seed = processHashSeed();
   std::size_t slots = 16;
   while (slots < std::size_t{in.vertexCount()} / 3) slots *= 2;
   std::vector<std::uint64_t> table(slots, kEmpty);
@@ -355,7 +349,7 @@ JoinedMesh joinVertices(const Vertices& in, std::size_t& dropped) {
     if (2 * keys.size() > slots) {
       slots *= 2;
       table.assign(slots, kEmpty);
-      for (std::uint32_t k = 0; k < keys.size(); ++k) place(hashOf(keys[k]), k);
+      for (std::uint32_t k = 0; k < keys.size(); ++k) place(hashOf(keys[k], seed), k);
     } else {
       place(hash, j);
     }
@@ -404,7 +398,7 @@ JoinedMesh joinVertices(const Vertices& in, std::size_t& dropped) {
       }
       cornerKeys[k] =
           keyOf(in.position(corners[k]), in.normal(corners[k]), in.texcoord(corners[k]));
-      hashes[k] = hashOf(cornerKeys[k]);
+      hashes[k] = hashOf(cornerKeys[k], seed);
       __builtin_prefetch(&table[hashes[k] & (slots - 1)]);
     }
     for (int k = 0; k < 3; ++k) {
@@ -471,16 +465,17 @@ bool isFinite(const Double3& p) {
   return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
 }
 
-// A hash of a float position's exact bits.
-std::uint64_t positionHash(const aiVector3D& v) {
+// A hash of a float position's exact bits, seeded (core/seeded_hash.h): a file cannot be made of
+// positions that all land in a few slots of the table below.
+std::uint64_t positionHash(const aiVector3D& v, std::uint64_t seed) {
   std::uint32_t bits[3];
   std::memcpy(bits, &v.x, 4);
   std::memcpy(bits + 1, &v.y, 4);
   std::memcpy(bits + 2, &v.z, 4);
-  std::uint64_t h = bits[0] * 0x9E3779B97F4A7C15ull;
-  h = (h ^ (h >> 29) ^ bits[1]) * 0xBF58476D1CE4E5B9ull;
-  h = (h ^ (h >> 31) ^ bits[2]) * 0x94D049BB133111EBull;
-  return h ^ (h >> 32);
+  SeededHasher h(seed);
+  h.add(bits[0] | std::uint64_t{bits[1]} << 32);
+  h.add(bits[2]);
+  return h.value();
 }
 
 bool samePosition(const aiVector3D& a, const aiVector3D& b) {
@@ -517,6 +512,7 @@ SmoothNormalsReport generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
   // Distinct positions (an open-addressing table of their first vertex), and the vertices at each
   // as compressed rows.
   const std::size_t slots = n + n / 2 + 1;
+  const std::uint64_t seed = processHashSeed();
   std::vector<std::uint32_t> slot(slots, kNone);
   std::vector<std::uint32_t> positionOf(n);
   std::vector<std::uint32_t> firstVertex;  // of each distinct position
@@ -527,7 +523,7 @@ SmoothNormalsReport generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
   for (std::size_t begin = 0; begin < n; begin += kBatch) {
     const std::size_t count = std::min(kBatch, n - begin);
     for (std::size_t k = 0; k < count; ++k) {
-      home[k] = static_cast<std::size_t>(positionHash(vertices[begin + k]) % slots);
+      home[k] = static_cast<std::size_t>(positionHash(vertices[begin + k], seed) % slots);
       __builtin_prefetch(&slot[home[k]]);
     }
     for (std::size_t k = 0; k < count; ++k) {

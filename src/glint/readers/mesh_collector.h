@@ -11,6 +11,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "glint/core/seeded_hash.h"
 #include "glint/readers/text_statements.h"
 
 namespace glint {
@@ -43,7 +44,8 @@ class MeshCollector {
     std::vector<CollectedVertex> vertices;
     std::vector<std::uint32_t> indices;
     std::vector<TextPosition> triangleAt;
-    std::unordered_map<std::string, std::uint32_t> shared;  // vertex text → index
+    std::unordered_map<std::string, std::uint32_t, SeededHash, std::equal_to<>>
+        shared;  // vertex text → index
   };
   std::uint32_t vertexIndex(const ValueTree& tree, Group& g, const CollectedVertex& v);
   std::vector<Group> groups_;

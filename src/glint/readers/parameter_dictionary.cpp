@@ -1,6 +1,7 @@
 #include "glint/readers/parameter_dictionary.h"
 
 #include "glint/core/bounds.h"
+#include "glint/core/seeded_hash.h"
 
 #include <algorithm>
 #include <charconv>
@@ -333,7 +334,7 @@ ParameterDictionary::ParameterDictionary(const ValueReader& reader, ValueId map,
   if (!tree.isMap(map)) return;
   const std::size_t n = tree.size(map);
   items_.reserve(n);
-  std::unordered_map<std::string_view, std::size_t> seen;  // only for large mappings
+  std::unordered_map<std::string_view, std::size_t, SeededHash> seen;  // only for large mappings
   if (n > kPairwiseDuplicateLimit) seen.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     const ValueId key = tree.key(map, i);

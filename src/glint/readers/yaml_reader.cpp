@@ -24,6 +24,7 @@
 #include <fmt/format.h>
 
 #include "glint/core/cancel.h"
+#include "glint/core/seeded_hash.h"
 #include "glint/readers/diagnostics.h"
 
 namespace glint::yaml {
@@ -766,7 +767,7 @@ class Reader {
   int documents_ = 0;
   std::vector<ValueId> stack_;
   std::vector<bool> mergeIn_;  // per open collection: it has a merge key `<<`
-  std::unordered_map<std::string, ValueId> anchors_;
+  std::unordered_map<std::string, ValueId, SeededHash, std::equal_to<>> anchors_;
   // Per value: values of its subtree with aliases expanded (saturating), and whether it is open.
   std::vector<std::uint64_t> weight_;
   std::vector<bool> open_;

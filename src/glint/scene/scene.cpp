@@ -11,6 +11,7 @@
 #include <utility>
 #include <variant>
 
+#include "glint/core/seeded_hash.h"
 #include "glint/core/spawn.h"
 #include "glint/geometry/csg.h"
 #include "glint/scene/scene_instances.h"
@@ -131,12 +132,13 @@ bool meshBoundsVolume(const TriangleMesh& mesh) {
   const std::size_t triangles = mesh.triangleCount();
   if (triangles < 4) return false;
   struct PositionHash {
+    std::uint64_t seed = processHashSeed();
     std::size_t operator()(const Point3& p) const {
-      std::uint64_t h = 0xcbf29ce484222325u;
+      SeededHasher h(seed);
       for (const double c : {p.x + 0.0, p.y + 0.0, p.z + 0.0}) {  // + 0.0: −0 and 0 alike
-        h = (h ^ std::bit_cast<std::uint64_t>(c)) * 0x100000001b3u;
+        h.add(std::bit_cast<std::uint64_t>(c));
       }
-      return static_cast<std::size_t>(h ^ (h >> 29));
+      return static_cast<std::size_t>(h.value());
     }
   };
   std::unordered_map<Point3, std::uint32_t, PositionHash> welded;
@@ -145,7 +147,7 @@ bool meshBoundsVolume(const TriangleMesh& mesh) {
     weldedId[i] =
         welded.emplace(mesh.positions[i], static_cast<std::uint32_t>(welded.size())).first->second;
   }
-  std::unordered_map<std::uint64_t, int> directedEdges;  // (from << 32 | to) → uses
+  std::unordered_map<std::uint64_t, int, SeededHash> directedEdges;  // (from << 32 | to) → uses
   double volume6 = 0;
   for (std::size_t t = 0; t < triangles; ++t) {
     const std::uint32_t* index = mesh.indices.data() + 3 * t;
@@ -425,7 +427,7 @@ void Scene::initialiseMedia() {
     std::uint32_t medium;
   };
   std::vector<Leaving> leaving;
-  std::unordered_set<std::uint64_t> seen;  // objects met: primitive, or mesh << 32
+  std::unordered_set<std::uint64_t, SeededHash> seen;  // objects met: primitive, or mesh << 32
   constexpr int kMaxCameraCrossings = 4096;
   const Vec3 direction = camera_.toward();
   Ray segment{camera_.position(), direction};
