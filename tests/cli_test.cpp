@@ -365,6 +365,26 @@ TEST_F(Cli, WarningsArePrintedButDoNotChangeTheExitStatus) {
   EXPECT_EQ(r.err, "") << "--quiet prints errors only";
 }
 
+// A file of many warnings prints the first 100 and how many more, not one line each (400,000
+// collinear NFF polygons printed 39 MB).
+TEST_F(Cli, WarningsPastAHundredAreCounted) {
+  std::string nff =
+      "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 8 8\n"
+      "l 0 5 5\nf 1 1 1 1 0 0 0 0\n";
+  for (int i = 0; i < 150; ++i) nff += "p 3\n0 0 0\n1 1 1\n2 2 2\n";
+  writeFile(work_ / "collinear.nff", nff);
+  const RunResult r = run({"check", "collinear.nff"});
+  EXPECT_EQ(r.status, 0) << r.err;
+  std::istringstream lines(r.err);
+  std::vector<std::string> shown;
+  for (std::string line; std::getline(lines, line);) shown.push_back(line);
+  ASSERT_EQ(shown.size(), 101u) << r.err;
+  EXPECT_EQ(shown[0],
+            "collinear.nff:10:1: warning: p: the polygon's vertices are collinear (no "
+            "area); it is left out");
+  EXPECT_EQ(shown[100], "glint: 50 more warnings not shown");
+}
+
 // --- output files are never broken ----------------------------------------------------------
 
 TEST_F(Cli, ExistingOutputIsUntouchedAfterABadScene) {

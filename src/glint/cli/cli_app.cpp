@@ -180,6 +180,20 @@ void printDiagnostics(const std::vector<Diagnostic>& diagnostics) {
   for (const Diagnostic& diagnostic : diagnostics) emit(stderr, diagnostic.format() + "\n");
 }
 
+// Warnings shown before the rest are only counted: a file of 400,000 collinear NFF polygons
+// printed 400,000 lines (39 MB).
+constexpr std::size_t kMaxShownWarnings = 100;
+
+// The first kMaxShownWarnings of `warnings` (in the loader's order: by place), then how many more.
+void printWarnings(const std::vector<Diagnostic>& warnings) {
+  const std::size_t shown = std::min(warnings.size(), kMaxShownWarnings);
+  for (std::size_t i = 0; i < shown; ++i) emit(stderr, warnings[i].format() + "\n");
+  if (warnings.size() > shown) {
+    const std::size_t more = warnings.size() - shown;
+    emit(stderr, fmt::format("glint: {} more warning{} not shown\n", more, more == 1 ? "" : "s"));
+  }
+}
+
 std::string formatPoint(const Point3& p) {
   return fmt::format("[{:g}, {:g}, {:g}]", p.x, p.y, p.z);
 }
@@ -320,7 +334,7 @@ int reportJobError(const JobError& error, const std::string& sceneFile) {
 
 int runCheck(const std::string& file, const std::optional<std::string>& maxMemory) {
   CheckOptions options;
-  options.warnings = printDiagnostics;
+  options.warnings = printWarnings;
   if (maxMemory) options.memoryBudget = parseMemorySize(*maxMemory);
   SceneFacts scene;
   try {
@@ -362,7 +376,7 @@ int runConvert(const std::string& file, const std::string& output, SignalGuard& 
     return SignalGuard::exitCodeFor(signals.receivedSignal() != 0 ? signals.receivedSignal()
                                                                   : SIGINT);
   }
-  printDiagnostics(result.warnings);
+  printWarnings(result.warnings);
   std::string files;
   for (const auto& mesh : result.meshFiles) files += ", " + mesh.string();
   emit(stdout,
@@ -446,7 +460,7 @@ int renderAndReport(RenderJobSpec spec, const RenderArgs& args, SignalGuard& sig
   ProgressReporter progress(
       args.quiet ? ProgressReporter::Style::Silent : ProgressReporter::styleFor(stderr), stderr);
   RenderJobEvents events;
-  if (!args.quiet) events.sceneWarnings = printDiagnostics;
+  if (!args.quiet) events.sceneWarnings = printWarnings;
   events.renderStarting = [&progress](std::size_t resumed, std::size_t) {
     progress.start(resumed);
   };
