@@ -26,9 +26,15 @@ const std::vector<std::string_view> kStatements = {"v", "b", "l", "f", "c", "s",
 constexpr std::size_t kStatementsPerPoll = 4096;
 // Vertices one polygon may have: far beyond any SPD polygon (the gears' 144), small enough that
 // ear clipping (quadratic in the vertices) stays fast.
-// Ear clipping (triangulate) takes time growing with the square of a polygon's corners or
-// faster: 4096 take ~0.5 s at worst (a star), 65536 took minutes. The SPD's largest is 144.
+// Ear clipping (triangulate) takes time growing with the square of a polygon's corners, and of
+// their cube for a polygon made to (one that winds around hundreds of times: 4096 corners took
+// 22 s) until its budget of point tests runs out (kEarTestsPerSquaredVertex). The SPD's largest
+// is 144.
 constexpr double kMaxPolygonVertices = 4096;
+// Point-in-triangle tests ear clipping may make per squared vertex count of a polygon before it
+// fans the rest: a simple polygon needs about one (each corner tested against the others, again
+// when a neighbour is clipped); 4096 corners get ~0.1 s.
+constexpr std::size_t kEarTestsPerSquaredVertex = 8;
 // A polygon vertex farther than this fraction of the polygon's size from its plane is warned
 // about: generated files write ~6 digits, far below it; a real bend is far above.
 constexpr double kPolygonPlaneTolerance = 1e-4;
@@ -525,7 +531,7 @@ class NffReader {
   // Ear clipping (Meisters 1975) of a planar polygon, projected onto the coordinate plane its
   // normal (Newell's) is most perpendicular to. Triangles keep the polygon's vertex order. A
   // polygon that clipping cannot finish (self-intersecting, repeated vertices) gets a fan for the
-  // rest.
+  // rest, as does one whose clipping runs out of its budget of tests (kEarTestsPerSquaredVertex).
   // `fanned`: set when the fan was needed.
   static std::vector<std::array<std::size_t, 3>> triangulate(const std::vector<Point3>& p,
                                                              const std::atomic<bool>* cancel,
@@ -552,6 +558,8 @@ class NffReader {
     for (std::size_t i = 0; i < n; ++i) ring[i] = i;
     std::vector<char> ear(n, 0);
     std::vector<std::size_t> blocker(n, kNone);  // per vertex: what lies in its corner's triangle
+    std::size_t tests = 0;                       // point-in-triangle tests so far
+    const std::size_t budget = kEarTestsPerSquaredVertex * n * n + 65536;
     const auto test = [&](std::size_t i) {
       const std::size_t m = ring.size();
       const std::size_t a = ring[(i + m - 1) % m];
@@ -562,6 +570,7 @@ class NffReader {
       if (!(turn(a, b, c) > 0)) return;  // a reflex or straight corner is no ear
       for (const std::size_t q : ring) {
         if (q == a || q == b || q == c) continue;
+        ++tests;
         if (turn(a, b, q) >= 0 && turn(b, c, q) >= 0 && turn(c, a, q) >= 0) {
           blocker[b] = q;
           return;
@@ -575,7 +584,7 @@ class NffReader {
       const std::size_t m = ring.size();
       std::size_t i = 0;
       while (i < m && !ear[ring[i]]) ++i;
-      if (i == m) {
+      if (i == m || tests > budget) {
         fanned = true;
         for (std::size_t k = 1; k + 1 < ring.size(); ++k) {
           out.push_back({ring[0], ring[k], ring[k + 1]});

@@ -197,6 +197,45 @@ TEST(NffReader, PolygonsThatCrossThemselvesOrBendAreWarnedAbout) {
             "(glint's coordinates stay below it)");
 }
 
+// A polygon made to make ear clipping cubic — it winds around a triangle hundreds of times and
+// ends in an arc its clipping takes in ring order, each clip re-testing most corners (4096 corners
+// took 22 s) — is clipped until its budget of tests runs out and fanned from there: all of its
+// n − 2 triangles, and the winding warning.
+TEST(NffReader, EarClippingStopsAtItsBudget) {
+  constexpr int kCorners = 3000;
+  constexpr int kArc = kCorners / 3;
+  constexpr int kRounds = (kCorners - kArc) / 3;
+  std::vector<std::pair<double, double>> points;
+  for (int i = 0; i < kRounds; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double angle = (90 + 120 * j) * std::numbers::pi / 180;
+      const double off = (i - kRounds / 2.0) * 1e-3 / kRounds;  // along the tangent
+      points.emplace_back(std::cos(angle) - std::sin(angle) * off,
+                          std::sin(angle) + std::cos(angle) * off);
+    }
+  }
+  const auto [px, py] = points.back();
+  const double radius = std::hypot(px, py);
+  const double base = std::atan2(-py, -px);
+  for (int j = 0; j < kArc; ++j) {  // an arc of length 0.2 about the last point, through the middle
+    const double angle = base - 0.1 / radius + 0.2 / radius * j / (kArc - 1);
+    points.emplace_back(px + radius * std::cos(angle), py + radius * std::sin(angle));
+  }
+  std::string nff =
+      "v from 0 0 10 at 0 0 0 up 0 1 0 angle 40 hither 1 resolution 8 8\n"
+      "l 0 10 10\nf 1 0 0 0.5 0.5 10 0 1\n" +
+      fmt::format("p {}\n", points.size());
+  for (const auto& [x, y] : points) nff += fmt::format("{:.17g} {:.17g} 0\n", x, y);
+  const ParseResult r = parseNff(nff, "a.nff");
+  ASSERT_FALSE(r.hasErrors()) << firstError(r);
+  const std::vector<std::string> warnings = warningsOf(r);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_THAT(warnings[0], ::testing::HasSubstr("the polygon winds around"));
+  const Entity& polygon = nth(r, EntityKind::ObjectEntity, 0);
+  const ValueTree& t = r.description.files[0]->values;
+  EXPECT_EQ(t.size(r.description.parameter(polygon, "indices")), points.size() - 2);
+}
+
 // Text that is no text: a NUL byte is refused at its place (it read as a blank); a UTF-8
 // byte-order mark at the start is skipped.
 TEST(NffReader, ANulByteIsRefusedAndAByteOrderMarkSkipped) {
