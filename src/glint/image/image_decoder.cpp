@@ -171,6 +171,20 @@ void jpegEmitMessage(j_common_ptr info, int level) {
   }
 }
 
+// Scans a progressive file may have (libjpeg-turbo's suggested scan limit): encoders write about
+// ten; a small file of thousands of scans, each redoing the whole image, took 27 s per MB.
+constexpr int kMaxJpegScans = 500;
+
+// Called by libjpeg as it reads (jpeg_progress_mgr): refuses a file past kMaxJpegScans scans.
+void jpegProgress(j_common_ptr info) {
+  if (!info->is_decompressor) return;
+  const auto* decompress = reinterpret_cast<j_decompress_ptr>(info);
+  if (decompress->input_scan_number <= kMaxJpegScans) return;
+  auto* error = reinterpret_cast<JpegError*>(info->err);
+  std::snprintf(error->message, sizeof error->message, "it has more than %d scans", kMaxJpegScans);
+  std::longjmp(error->jump, 1);
+}
+
 bool decodeJpegSamples(std::span<const std::uint8_t> file, const ImageHeader& header,
                        std::vector<std::uint8_t>& samples, JpegError& error) {
   // A file whose data is whole but lacks the end marker (FF D9) decodes as if it had one: the
@@ -185,6 +199,8 @@ bool decodeJpegSamples(std::span<const std::uint8_t> file, const ImageHeader& he
     ended.push_back(0xD9);
     bytes = ended;
   }
+  jpeg_progress_mgr progress{};
+  progress.progress_monitor = jpegProgress;
   jpeg_decompress_struct info;
   info.err = jpeg_std_error(&error.manager);
   error.manager.error_exit = jpegErrorExit;
@@ -195,6 +211,7 @@ bool decodeJpegSamples(std::span<const std::uint8_t> file, const ImageHeader& he
     return false;
   }
   jpeg_create_decompress(&info);
+  info.progress = &progress;
   // Progressive files buffer every coefficient: cap the memory libjpeg may take for them.
   info.mem->max_memory_to_use =
       std::max<long>(64L << 20, static_cast<long>(header.width) * header.height * 8);

@@ -245,5 +245,51 @@ TEST(ImageDecoder, ReadsRegularFilesOnly) {
   EXPECT_EQ(seen, 3);
 }
 
+// A progressive JPEG of one 8 × 8 grey block: a DC scan, then `acScans` identical AC scans (each
+// one end-of-band run) — valid to libjpeg, and each scan a pass over the whole image.
+std::vector<std::uint8_t> progressiveJpeg(int acScans) {
+  std::vector<std::uint8_t> f = {0xFF, 0xD8};
+  const auto segment = [&](std::uint8_t marker, std::vector<std::uint8_t> payload) {
+    const std::size_t length = payload.size() + 2;
+    f.insert(f.end(), {0xFF, marker, static_cast<std::uint8_t>(length >> 8),
+                       static_cast<std::uint8_t>(length)});
+    f.insert(f.end(), payload.begin(), payload.end());
+  };
+  std::vector<std::uint8_t> table = {0};  // DQT: table 0, all ones
+  table.resize(65, 1);
+  segment(0xDB, table);
+  segment(0xC2, {8, 0, 8, 0, 8, 1, 1, 0x11, 0});  // SOF2: 8 × 8, one component
+  std::vector<std::uint8_t> dc = {0x00, 1};       // DHT DC 0: one code of length 1, symbol 0
+  dc.resize(17, 0);
+  dc.push_back(0);
+  segment(0xC4, dc);
+  std::vector<std::uint8_t> ac = {0x10, 1};  // DHT AC 0: one code of length 1, symbol 0 (EOB)
+  ac.resize(17, 0);
+  ac.push_back(0);
+  segment(0xC4, ac);
+  segment(0xDA, {1, 1, 0x00, 0, 0, 0x00});  // SOS: DC first scan
+  f.push_back(0x7F);                        // the block's DC difference 0 (bit 0), padded with 1s
+  for (int k = 0; k < acScans; ++k) {
+    segment(0xDA, {1, 1, 0x00, 1, 63, 0x00});  // SOS: AC 1..63 first scan
+    f.push_back(0x7F);                         // EOB, padded with 1s
+  }
+  f.insert(f.end(), {0xFF, 0xD9});
+  return f;
+}
+
+// A file of thousands of scans redoes the image for each (27 s per MB of them): past 500 scans
+// (libjpeg-turbo's suggested limit; encoders write about ten) it is refused, naming why.
+TEST(ImageDecoder, ProgressiveJpegsOfTooManyScansAreRefused) {
+  const RgbImage grey = decodeImage(progressiveJpeg(499), ImageEncoding::Linear);
+  ASSERT_EQ(grey.width, 8);
+  ASSERT_EQ(grey.height, 8);
+  try {
+    decodeImage(progressiveJpeg(500), ImageEncoding::Linear);
+    FAIL() << "501 scans decoded";
+  } catch (const ImageReadError& e) {
+    EXPECT_STREQ(e.what(), "invalid JPEG file: it has more than 500 scans");
+  }
+}
+
 }  // namespace
 }  // namespace glint
