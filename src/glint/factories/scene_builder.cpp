@@ -589,16 +589,17 @@ class Builder {
                                 named, file->droppedTriangles,
                                 file->droppedTriangles == 1 ? "" : "s", triangles));
     }
-    if (file->exactPositionNormalParts > 0) {
+    // (With `smooth: false` the generated normals are not used.)
+    if (file->exactPositionNormalParts > 0 && request.smooth) {
       sink_.warning(
           params.location(),
           fmt::format("{}: its generated normals smooth only over vertices at exactly the "
                       "same position: within the usual radius (1e-4 of the bounding "
-                      "box's diagonal) too many vertices are near one another — is "
-                      "there a vertex far from the rest?",
+                      "box's diagonal) too many vertices are near one another (a "
+                      "vertex far from the rest, or fine detail in a large mesh)",
                       named));
     }
-    if (file->crowdedNormalPositions > 0) {
+    if (file->crowdedNormalPositions > 0 && request.smooth) {
       sink_.warning(params.location(),
                     fmt::format("{}: in its generated normals, at {} position{} shared by more "
                                 "than {} triangle corners each corner keeps its own triangle's "

@@ -544,11 +544,11 @@ TEST(SceneBuilder, NamesInErrorsAreFewShortAndEscaped) {
   ASSERT_EQ(errors.size(), 2u);
   EXPECT_EQ(errors[0].message,
             "sphere.material: undefined material "
-            "'nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn...'; no materials are "
-            "defined");
+            "'nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn...'; names are at most 256 "
+            "bytes");
   EXPECT_EQ(errors[1].message,
             "instance.group: undefined group "
-            "'nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn...'; no groups are defined");
+            "'nnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnnn...'; names are at most 256 bytes");
 }
 
 // Points past ±1e100 are errors at the value; objects that sizes or transforms carry past it at
@@ -1052,18 +1052,19 @@ TEST(SceneBuilder, MeshGeneratedNormalsThatGiveUpSmoothingAreWarnings) {
   const LoadedScene loaded = loadIn(dir, std::string(kMinimal) + kLit +
                                              "objects:\n"
                                              "  - {type: mesh, file: outlier.obj}\n"
-                                             "  - {type: mesh, file: fan.obj}\n");
-  ASSERT_EQ(loaded.warnings.size(), 2u);
+                                             "  - {type: mesh, file: fan.obj}\n"
+                                             "  - {type: mesh, file: fan.obj, smooth: false}\n");
+  ASSERT_EQ(loaded.warnings.size(), 2u);  // flat facets use no generated normals: no warning
   EXPECT_EQ(loaded.warnings[0].format(),
             "meshes.yaml:5:5: warning: mesh file 'outlier.obj': its generated normals smooth only "
             "over vertices at exactly the same position: within the usual radius (1e-4 of the "
-            "bounding box's diagonal) too many vertices are near one another — is there a vertex "
-            "far from the rest?");
+            "bounding box's diagonal) too many vertices are near one another (a vertex far from "
+            "the rest, or fine detail in a large mesh)");
   EXPECT_EQ(loaded.warnings[1].format(),
             "meshes.yaml:6:5: warning: mesh file 'fan.obj': in its generated normals, at 1 "
             "position shared by more than 1024 triangle corners each corner keeps its own "
             "triangle's normal");
-  ASSERT_EQ(loaded.parts.meshes.size(), 2u);
+  ASSERT_EQ(loaded.parts.meshes.size(), 3u);
   // The grid is flat: its normals are straight up (or down) whichever way they were smoothed.
   const TriangleMesh& flat = loaded.parts.meshes[0];
   ASSERT_EQ(flat.normals.size(), flat.positions.size());

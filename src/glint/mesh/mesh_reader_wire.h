@@ -48,8 +48,9 @@ inline bool writeMessage(int fd, char tag, const std::string& text) {
          writeAll(fd, text.data(), text.size());
 }
 
-// The whole answer: 'M', the dropped triangles, the textures the materials name that glint does not
-// use, then the file's materials, embedded images and parts.
+// The whole answer: 'M', the dropped triangles, the generated normals' two counts
+// (exactPositionNormalParts, crowdedNormalPositions), the textures the materials name that glint
+// does not use, then the file's materials, embedded images and parts.
 bool writeMeshFile(int fd, const MeshFile& file);
 
 }  // namespace glint::wire

@@ -84,7 +84,7 @@ struct VertexKey {
   float p[3];
   float n[3];
   float t[2];
-  // The same bits (as hashOf reads them): −0 and 0 are two keys whatever the table's seed.
+  // The same bits, as hashOf reads them (keyOf has made −0 +0 already).
   bool operator==(const VertexKey& o) const { return std::memcmp(this, &o, sizeof o) == 0; }
 };
 
@@ -465,13 +465,17 @@ bool isFinite(const Double3& p) {
   return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
 }
 
-// A hash of a float position's exact bits, seeded (core/seeded_hash.h): a file cannot be made of
-// positions that all land in a few slots of the table below.
+// A position with −0 made +0: the two are one position (as keyOf and meshBoundsVolume take them).
+aiVector3D canonical(const aiVector3D& v) { return {v.x + 0.0f, v.y + 0.0f, v.z + 0.0f}; }
+
+// A hash of a float position's bits (−0 as +0), seeded (core/seeded_hash.h): a file cannot be made
+// of positions that all land in a few slots of the table below.
 std::uint64_t positionHash(const aiVector3D& v, std::uint64_t seed) {
+  const aiVector3D c = canonical(v);
   std::uint32_t bits[3];
-  std::memcpy(bits, &v.x, 4);
-  std::memcpy(bits + 1, &v.y, 4);
-  std::memcpy(bits + 2, &v.z, 4);
+  std::memcpy(bits, &c.x, 4);
+  std::memcpy(bits + 1, &c.y, 4);
+  std::memcpy(bits + 2, &c.z, 4);
   SeededHasher h(seed);
   h.add(bits[0] | std::uint64_t{bits[1]} << 32);
   h.add(bits[2]);
@@ -479,7 +483,9 @@ std::uint64_t positionHash(const aiVector3D& v, std::uint64_t seed) {
 }
 
 bool samePosition(const aiVector3D& a, const aiVector3D& b) {
-  return std::memcmp(&a, &b, sizeof(aiVector3D)) == 0;
+  const aiVector3D ca = canonical(a);
+  const aiVector3D cb = canonical(b);
+  return std::memcmp(&ca, &cb, sizeof(aiVector3D)) == 0;
 }
 
 }  // namespace
@@ -569,12 +575,15 @@ SmoothNormalsReport generateSmoothNormals(aiMesh& mesh, double creaseDegrees) {
           : 0;
   const double epsilon = 1e-4 * diagonal;
 
-  // The distinct positions within epsilon of each (itself included), from a grid of cells 16
-  // epsilon wide sorted by cell: a position looks in its own cell and the neighbours its epsilon
+  // The distinct positions within epsilon of each (itself included), from a grid of cells sorted
+  // by cell: a position looks in its own cell and the neighbours its epsilon
   // ball reaches into. Found one position at a time (a far outlier can make epsilon cover the
   // whole model: then every position is near every other, and a stored list would be quadratic).
-  const double cell = 16 * epsilon;
-  // Cells along an axis: at most diagonal / cell + 1 = 626, so 21 bits each make a key.
+  // Cells two epsilon wide: a ball reaches at most one neighbour along each axis, and a cell holds
+  // few positions beyond the ball's own (16 epsilon scanned ~30 times as many: a dense small part
+  // of a large mesh, a fine sphere on a wide ground, passed the budget below).
+  const double cell = 2 * epsilon;
+  // Cells along an axis: at most diagonal / cell + 1 = 5001, so 21 bits each make a key.
   const auto cellOf = [&](double value, double origin) {
     return static_cast<std::int64_t>(std::floor((value - origin) / cell));
   };

@@ -17,6 +17,7 @@
 #include <tuple>
 #include <vector>
 
+#include "glint/core/seeded_hash.h"
 #include "glint/mesh/mesh_file.h"
 #include "glint/mesh/mesh_test_support.h"
 
@@ -361,6 +362,60 @@ TEST(MeshRepair, GeneratedNormalsAtACrowdedPositionKeepTheirFaceNormals) {
       ASSERT_NEAR(mesh.mNormals[i].z, own.z, 1e-6) << i;
     }
   }
+}
+
+// The tables that group vertices and positions are seeded per process (core/seeded_hash.h) so
+// that no file can make them collide; what they give — joined vertices numbered by first use,
+// generated normals, in the normal case and in the exact-position fallback (with −0 written
+// beside 0) — must be the same under any seed.
+TEST(MeshRepair, JoinsAndNormalsDoNotDependOnTheHashSeed) {
+  std::vector<Point3> corners;
+  constexpr int kCells = 60;
+  const auto point = [](int i, int j) {
+    return Point3{i / 60.0, 0.02 * std::sin(0.7 * i) * std::cos(0.9 * j), j / 60.0};
+  };
+  for (int i = 0; i < kCells; ++i) {
+    for (int j = 0; j < kCells; ++j) {
+      for (const Point3& p : {point(i, j), point(i + 1, j + 1), point(i + 1, j), point(i, j),
+                              point(i, j + 1), point(i + 1, j + 1)}) {
+        corners.push_back(p.z == 0 && i % 2 == 1 ? Point3{p.x, p.y, -0.0} : p);
+      }
+    }
+  }
+  struct Result {
+    std::vector<std::array<float, 3>> normals;
+    JoinedMesh joined;
+    bool exactPositionsOnly;
+  };
+  const auto run = [&](std::uint64_t seed, bool outlier) {
+    setProcessHashSeedForTesting(seed);
+    std::vector<Point3> all = corners;
+    if (outlier) all.insert(all.end(), {{1e6, 0, 0}, {1e6, 0, 1}, {1e6, 1, 0}});
+    aiMesh mesh;
+    setCorners(mesh, all);
+    Result r;
+    r.exactPositionsOnly = generateSmoothNormals(mesh, kMeshCreaseAngleDegrees).exactPositionsOnly;
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+      r.normals.push_back({mesh.mNormals[v].x, mesh.mNormals[v].y, mesh.mNormals[v].z});
+    }
+    std::size_t dropped = 0;
+    r.joined = joinMesh(mesh, dropped);
+    return r;
+  };
+  const std::uint64_t saved = processHashSeed();
+  for (const bool outlier : {false, true}) {
+    SCOPED_TRACE(outlier);
+    const Result a = run(1, outlier);
+    const Result b = run(0x9e3779b97f4a7c15ull, outlier);
+    EXPECT_EQ(a.exactPositionsOnly, outlier);
+    EXPECT_EQ(b.exactPositionsOnly, outlier);
+    EXPECT_EQ(a.normals, b.normals);
+    EXPECT_EQ(a.joined.indices, b.joined.indices);
+    EXPECT_EQ(a.joined.source, b.joined.source);
+    // −0 and 0 are one position and one vertex: the grid's points (and the outlier's three).
+    EXPECT_EQ(a.joined.source.size(), (kCells + 1u) * (kCells + 1u) + (outlier ? 3u : 0u));
+  }
+  setProcessHashSeedForTesting(saved);
 }
 
 TEST(MeshRepair, IndexedFilesWithoutNormalsGetSmoothNormalsPerVertex) {

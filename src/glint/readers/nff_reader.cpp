@@ -24,17 +24,16 @@ const std::vector<std::string_view> kStatements = {"v", "b", "l", "f", "c", "s",
 
 // Statements between polls of the cancel flag.
 constexpr std::size_t kStatementsPerPoll = 4096;
-// Vertices one polygon may have: far beyond any SPD polygon (the gears' 144), small enough that
-// ear clipping (quadratic in the vertices) stays fast.
-// Ear clipping (triangulate) takes time growing with the square of a polygon's corners, and of
-// their cube for a polygon made to (one that winds around hundreds of times: 4096 corners took
-// 22 s) until its budget of point tests runs out (kEarTestsPerSquaredVertex). The SPD's largest
-// is 144.
+// Vertices one polygon may have: far beyond any SPD polygon (the gears' 144). Ear clipping
+// (triangulate) takes time growing with the square of a polygon's corners, and with their cube
+// for a polygon made to (one that winds around hundreds of times: 4096 corners took 22 s) until its
+// budget of point tests runs out (kEarTestsPerSquaredVertex).
 constexpr double kMaxPolygonVertices = 4096;
 // Point-in-triangle tests ear clipping may make per squared vertex count of a polygon before it
-// fans the rest: a simple polygon needs about one (each corner tested against the others, again
-// when a neighbour is clipped); 4096 corners get ~0.1 s.
+// fans the rest: simple polygons (convex, stars, spirals, crescents) need at most about two (each
+// corner tested against the others, again when a neighbour is clipped); 4096 corners get ~0.3 s.
 constexpr std::size_t kEarTestsPerSquaredVertex = 8;
+constexpr std::size_t kEarTestsBase = 65536;
 // A polygon vertex farther than this fraction of the polygon's size from its plane is warned
 // about: generated files write ~6 digits, far below it; a real bend is far above.
 constexpr double kPolygonPlaneTolerance = 1e-4;
@@ -428,13 +427,23 @@ class NffReader {
     }
     const std::string m = material(false);
     bool fanned = false;
-    const std::vector<std::array<std::size_t, 3>> triangles = triangulate(points, cancel_, fanned);
+    bool outOfBudget = false;
+    const std::vector<std::array<std::size_t, 3>> triangles =
+        triangulate(points, cancel_, fanned, outOfBudget);
     if (triangles.empty()) {
       out_.warning(p.at, fmt::format("{}: the polygon{}; it is left out", p.text,
                                      collinear(points) ? "'s vertices are collinear (no area)"
                                                        : " crosses itself so that its parts "
                                                          "enclose opposite areas that cancel"));
       return;
+    }
+    if (outOfBudget) {
+      out_.warning(p.at, fmt::format("{}: cutting the polygon into triangles took more than {} "
+                                     "tests of its corners; the rest of it is a fan of triangles, "
+                                     "which may cover other parts than meant",
+                                     p.text,
+                                     kEarTestsPerSquaredVertex * points.size() * points.size() +
+                                         kEarTestsBase));
     }
     if (const long turns = windings(points); turns > 1) {
       out_.warning(p.at, fmt::format("{}: the polygon winds around {} times (it crosses itself, "
@@ -532,10 +541,10 @@ class NffReader {
   // normal (Newell's) is most perpendicular to. Triangles keep the polygon's vertex order. A
   // polygon that clipping cannot finish (self-intersecting, repeated vertices) gets a fan for the
   // rest, as does one whose clipping runs out of its budget of tests (kEarTestsPerSquaredVertex).
-  // `fanned`: set when the fan was needed.
+  // `fanned`: set when the fan was needed; `outOfBudget` too when the budget ran out.
   static std::vector<std::array<std::size_t, 3>> triangulate(const std::vector<Point3>& p,
                                                              const std::atomic<bool>* cancel,
-                                                             bool& fanned) {
+                                                             bool& fanned, bool& outOfBudget) {
     const std::size_t n = p.size();
     const Vec3 normal = newellNormal(p);
     std::vector<std::array<std::size_t, 3>> out;
@@ -559,7 +568,7 @@ class NffReader {
     std::vector<char> ear(n, 0);
     std::vector<std::size_t> blocker(n, kNone);  // per vertex: what lies in its corner's triangle
     std::size_t tests = 0;                       // point-in-triangle tests so far
-    const std::size_t budget = kEarTestsPerSquaredVertex * n * n + 65536;
+    const std::size_t budget = kEarTestsPerSquaredVertex * n * n + kEarTestsBase;
     const auto test = [&](std::size_t i) {
       const std::size_t m = ring.size();
       const std::size_t a = ring[(i + m - 1) % m];
@@ -586,6 +595,7 @@ class NffReader {
       while (i < m && !ear[ring[i]]) ++i;
       if (i == m || tests > budget) {
         fanned = true;
+        outOfBudget = i < m;
         for (std::size_t k = 1; k + 1 < ring.size(); ++k) {
           out.push_back({ring[0], ring[k], ring[k + 1]});
         }

@@ -69,32 +69,36 @@ std::string closestName(std::string_view word, const Names& candidates) {
 template <class Names>
 std::string didYouMean(std::string_view word, const Names& candidates) {
   const std::string best = closestName(word, candidates);
-  return best.empty() ? std::string() : " (did you mean '" + shortenForMessage(best) + "'?)";
+  return best.empty() ? std::string() : " (did you mean '" + nameForMessage(best) + "'?)";
 }
 
 // The hint after "undefined material 'x'" (and texture, group): " (did you mean 'y'?)" when a
-// defined name is close, else "; defined: a, b, c" — at most kListedNames of them and how many
-// more, each as messages quote the scene's text (shortened, escaped) —, else `none` when nothing
-// is defined. Each hint reads every defined name, so only the first kMaxNameHints undefined names
-// of a kind get one (`hintsLeft` counts down; the loader prints 20 errors): a file of thousands
-// of undefined names among thousands of definitions took minutes.
+// defined name is close, else "; defined: a, b, c and 37 more" — the first kListedNames in byte
+// order, as messages show names (nameForMessage) —, else `none` when nothing is defined. A word
+// longer than any name may be says so. The did-you-mean search reads every defined name, so only
+// the first kMaxNameHints undefined names of a kind get one (`hintsLeft` counts down; the rest get
+// the list): thousands of undefined names among thousands of definitions took minutes.
 // `defined`: a map whose keys are the defined names.
 inline constexpr std::size_t kListedNames = 10;
 inline constexpr int kMaxNameHints = 20;
 template <class Map>
 std::string undefinedNameHint(std::string_view word, const Map& defined, std::string_view none,
                               int& hintsLeft) {
+  if (word.size() > kMaxNameBytes) {
+    return "; names are at most " + std::to_string(kMaxNameBytes) + " bytes";
+  }
   if (defined.empty()) return std::string(none);
-  if (hintsLeft <= 0) return {};
-  --hintsLeft;
-  std::string hint = didYouMean(word, std::views::keys(defined));
-  if (!hint.empty()) return hint;
-  hint = "; defined: ";
+  if (hintsLeft > 0) {
+    --hintsLeft;
+    std::string hint = didYouMean(word, std::views::keys(defined));
+    if (!hint.empty()) return hint;
+  }
+  std::string hint = "; defined: ";
   std::size_t listed = 0;
   for (const auto& entry : defined) {
     if (listed == kListedNames) break;
     if (listed++ > 0) hint += ", ";
-    hint += shortenForMessage(entry.first);
+    hint += nameForMessage(entry.first);
   }
   if (defined.size() > kListedNames) {
     hint += " and " + std::to_string(defined.size() - kListedNames) + " more";

@@ -383,7 +383,7 @@ class TachyonReader {
   // A texture name becomes a material name of the scene (and a YAML key when converted): at most
   // 256 bytes of UTF-8 text without control characters. VMD writes short ASCII names.
   void requireTextureName(const Token& statement, const Token& name) {
-    constexpr std::size_t kLongestName = 256;
+    constexpr std::size_t kLongestName = kMaxNameBytes;  // as a YAML scene's names
     const std::string_view text = name.text;
     bool ok = text.size() <= kLongestName;
     for (std::size_t i = 0; ok && i < text.size();) {

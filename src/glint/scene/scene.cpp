@@ -133,7 +133,7 @@ bool meshBoundsVolume(const TriangleMesh& mesh) {
   if (triangles < 4) return false;
   struct PositionHash {
     std::uint64_t seed = processHashSeed();
-    std::size_t operator()(const Point3& p) const {
+    std::size_t operator()(const Point3& p) const noexcept {
       SeededHasher h(seed);
       for (const double c : {p.x + 0.0, p.y + 0.0, p.z + 0.0}) {  // + 0.0: −0 and 0 alike
         h.add(std::bit_cast<std::uint64_t>(c));
