@@ -42,7 +42,7 @@ void splitSharedCorners(aiScene& scene);
 // that uses it (p1 − p0) × (p_last − p0); then its normal is the normalised sum of those normals
 // over the vertices within epsilon of its position (1e-4 of the mesh's bounding-box diagonal)
 // whose normal lies within `creaseDegrees` of its own (itself always). Vertices within epsilon are
-// found through a grid of cells 2 epsilon wide over the distinct positions. Computed in double
+// found through a grid of cells 4 epsilon wide over the distinct positions. Computed in double
 // precision, stored as floats; a vertex of no face gets NaN (convertMesh rebuilds it or drops it).
 //
 // Comparing the vertices near each other pairwise is quadratic where many are near one another,
