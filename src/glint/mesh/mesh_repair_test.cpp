@@ -142,33 +142,24 @@ std::string icosahedronPly() {
   return ply.str();
 }
 
-// generateSmoothNormals against its definition computed the slow way (every pair of vertices):
-// the normalised sum of the unit face normals of the vertices within epsilon (1e-4 of the
-// bounding box's diagonal) whose face lies within the crease angle — on a bumpy sphere of one
-// vertex per corner, some corners moved by 0.3 epsilon (still merged) or 3 epsilon (not).
-TEST(MeshRepair, GeneratedNormalsFollowTheirDefinition) {
-  constexpr int kRings = 12;
-  constexpr int kSegments = 24;
-  const auto point = [&](int ring, int segment) {
-    const double theta = std::numbers::pi * ring / kRings;
-    const double phi = 2 * std::numbers::pi * segment / kSegments;
-    const double radius = 1 + 0.15 * std::sin(3 * theta) * std::cos(5 * phi);  // bumps and creases
-    return Point3{radius * std::sin(theta) * std::cos(phi), radius * std::cos(theta),
-                  radius * std::sin(theta) * std::sin(phi)};
-  };
+// The corners of a rows × columns grid of quads, two triangles each (a, b, c and a, c, d of the
+// quad with corners point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)).
+template <class PointAt>
+std::vector<Point3> gridCorners(int rows, int columns, const PointAt& point) {
   std::vector<Point3> corners;
-  for (int r = 0; r < kRings; ++r) {
-    for (int s = 0; s < kSegments; ++s) {
-      const Point3 a = point(r, s), b = point(r + 1, s), c = point(r + 1, s + 1),
-                   d = point(r, s + 1);
+  for (int i = 0; i < rows; ++i) {
+    for (int j = 0; j < columns; ++j) {
+      const Point3 a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1),
+                   d = point(i, j + 1);
       for (const Point3& p : {a, b, c, a, c, d}) corners.push_back(p);
     }
   }
-  const double epsilon = 1e-4 * std::sqrt(2.0 * 2.0 * 3);  // the bumps stay within ±1.15: close
-  for (std::size_t i = 0; i < corners.size(); i += 37) corners[i].x += 0.3 * epsilon;
-  for (std::size_t i = 5; i < corners.size(); i += 41) corners[i].y += 3 * epsilon;
+  return corners;
+}
 
-  aiMesh mesh;
+// An assimp mesh of one vertex per corner, three corners per triangle (as assimp's OBJ importer
+// gives), positions rounded to float as assimp stores them.
+void setCorners(aiMesh& mesh, const std::vector<Point3>& corners) {
   mesh.mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
   mesh.mNumVertices = static_cast<unsigned>(corners.size());
   mesh.mVertices = new aiVector3D[corners.size()];
@@ -183,6 +174,41 @@ TEST(MeshRepair, GeneratedNormalsFollowTheirDefinition) {
     mesh.mFaces[f].mNumIndices = 3;
     mesh.mFaces[f].mIndices = new unsigned[3]{3 * f, 3 * f + 1, 3 * f + 2};
   }
+}
+
+// The unit normal of the triangle of corner i (zero for one of no area), from the float positions.
+Vec3 cornerFaceNormal(const aiMesh& mesh, std::size_t i) {
+  const auto at = [&](std::size_t k) {
+    const aiVector3D& v = mesh.mVertices[k];
+    return Point3{v.x, v.y, v.z};
+  };
+  const std::size_t f = i / 3;
+  const Vec3 n = cross(at(3 * f + 1) - at(3 * f), at(3 * f + 2) - at(3 * f));
+  const double length = std::sqrt(dot(n, n));
+  return length > 0 ? n / length : n;
+}
+
+// generateSmoothNormals against its definition computed the slow way (every pair of vertices):
+// the normalised sum of the unit face normals of the vertices within epsilon (1e-4 of the
+// bounding box's diagonal) whose face lies within the crease angle — on a bumpy sphere of one
+// vertex per corner, some corners moved by 0.3 epsilon (still merged) or 3 epsilon (not).
+TEST(MeshRepair, GeneratedNormalsFollowTheirDefinition) {
+  constexpr int kRings = 12;
+  constexpr int kSegments = 24;
+  const auto point = [&](int ring, int segment) {
+    const double theta = std::numbers::pi * ring / kRings;
+    const double phi = 2 * std::numbers::pi * segment / kSegments;
+    const double radius = 1 + 0.15 * std::sin(3 * theta) * std::cos(5 * phi);  // bumps and creases
+    return Point3{radius * std::sin(theta) * std::cos(phi), radius * std::cos(theta),
+                  radius * std::sin(theta) * std::sin(phi)};
+  };
+  std::vector<Point3> corners = gridCorners(kRings, kSegments, point);
+  const double epsilon = 1e-4 * std::sqrt(2.0 * 2.0 * 3);  // the bumps stay within ±1.15: close
+  for (std::size_t i = 0; i < corners.size(); i += 37) corners[i].x += 0.3 * epsilon;
+  for (std::size_t i = 5; i < corners.size(); i += 41) corners[i].y += 3 * epsilon;
+
+  aiMesh mesh;
+  setCorners(mesh, corners);
   generateSmoothNormals(mesh, kMeshCreaseAngleDegrees);
 
   // The definition, from the float positions as the function reads them.
@@ -228,37 +254,6 @@ TEST(MeshRepair, GeneratedNormalsFollowTheirDefinition) {
   EXPECT_GT(merged, 0);  // some moved corners were within epsilon of others
 }
 
-// An assimp mesh of one vertex per corner, three corners per triangle (as assimp's OBJ importer
-// gives), positions rounded to float as assimp stores them.
-void setCorners(aiMesh& mesh, const std::vector<Point3>& corners) {
-  mesh.mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
-  mesh.mNumVertices = static_cast<unsigned>(corners.size());
-  mesh.mVertices = new aiVector3D[corners.size()];
-  for (std::size_t i = 0; i < corners.size(); ++i) {
-    mesh.mVertices[i] =
-        aiVector3D(static_cast<float>(corners[i].x), static_cast<float>(corners[i].y),
-                   static_cast<float>(corners[i].z));
-  }
-  mesh.mNumFaces = mesh.mNumVertices / 3;
-  mesh.mFaces = new aiFace[mesh.mNumFaces];
-  for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
-    mesh.mFaces[f].mNumIndices = 3;
-    mesh.mFaces[f].mIndices = new unsigned[3]{3 * f, 3 * f + 1, 3 * f + 2};
-  }
-}
-
-// The unit normal of the triangle of corner i (zero for one of no area), from the float positions.
-Vec3 cornerFaceNormal(const aiMesh& mesh, std::size_t i) {
-  const auto at = [&](std::size_t k) {
-    const aiVector3D& v = mesh.mVertices[k];
-    return Point3{v.x, v.y, v.z};
-  };
-  const std::size_t f = i / 3;
-  const Vec3 n = cross(at(3 * f + 1) - at(3 * f), at(3 * f + 2) - at(3 * f));
-  const double length = std::sqrt(dot(n, n));
-  return length > 0 ? n / length : n;
-}
-
 // Checks the normals of the corners `which` against the smoothing over exactly equal positions:
 // the normalised sum of the face normals, within the crease angle, of the corners at exactly
 // corner i's position (itself always).
@@ -295,14 +290,7 @@ TEST(MeshRepair, GeneratedNormalsWithAFarOutlierSmoothOverExactPositions) {
   const auto point = [&](int i, int j) {
     return Point3{static_cast<double>(i) / kCells, height(i, j), static_cast<double>(j) / kCells};
   };
-  std::vector<Point3> corners;
-  for (int i = 0; i < kCells; ++i) {
-    for (int j = 0; j < kCells; ++j) {
-      const Point3 a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1),
-                   d = point(i, j + 1);
-      for (const Point3& p : {a, c, b, a, d, c}) corners.push_back(p);
-    }
-  }
+  std::vector<Point3> corners = gridCorners(kCells, kCells, point);
   for (const Point3& p : {Point3{1e6, 0, 0}, Point3{1e6, 0, 1}, Point3{1e6, 1, 0}}) {
     corners.push_back(p);
   }
@@ -369,18 +357,13 @@ TEST(MeshRepair, GeneratedNormalsAtACrowdedPositionKeepTheirFaceNormals) {
 // generated normals, in the normal case and in the exact-position fallback (with −0 written
 // beside 0) — must be the same under any seed.
 TEST(MeshRepair, JoinsAndNormalsDoNotDependOnTheHashSeed) {
-  std::vector<Point3> corners;
   constexpr int kCells = 60;
   const auto point = [](int i, int j) {
     return Point3{i / 60.0, 0.02 * std::sin(0.7 * i) * std::cos(0.9 * j), j / 60.0};
   };
-  for (int i = 0; i < kCells; ++i) {
-    for (int j = 0; j < kCells; ++j) {
-      for (const Point3& p : {point(i, j), point(i + 1, j + 1), point(i + 1, j), point(i, j),
-                              point(i, j + 1), point(i + 1, j + 1)}) {
-        corners.push_back(p.z == 0 && i % 2 == 1 ? Point3{p.x, p.y, -0.0} : p);
-      }
-    }
+  std::vector<Point3> corners = gridCorners(kCells, kCells, point);
+  for (std::size_t k = 0; k < corners.size(); k += 2) {  // some corners on z = 0 written as −0
+    if (corners[k].z == 0) corners[k].z = -0.0;
   }
   struct Result {
     std::vector<std::array<float, 3>> normals;
