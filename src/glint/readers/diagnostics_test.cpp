@@ -43,7 +43,7 @@ TEST(Spelling, UndefinedNamesGetHintsWithinABudget) {
   EXPECT_EQ(undefinedNameHint("glas", std::map<std::string, int>(), "; none", hintsLeft), "; none");
   EXPECT_EQ(undefinedNameHint(std::string(257, 'g'), names, "; none", hintsLeft),
             "; names are at most 256 bytes");
-  EXPECT_EQ(closestName(std::string(kLongName).substr(1), std::views::keys(names)), "");
+  EXPECT_EQ(closestName(std::string(kLongName).substr(1), names), "");
 }
 
 }  // namespace

@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cstddef>
-#include <ranges>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "glint/readers/diagnostics.h"
@@ -38,6 +38,17 @@ inline std::size_t editDistance(std::string_view a, std::string_view b) {
   return d[a.size() * columns + b.size()];
 }
 
+// A candidate's name: itself, or a map entry's key. (Not std::views::keys: clang before 16 cannot
+// compile libstdc++ 12's views, and the fuzzers build with clang.)
+template <class T>
+std::string_view candidateName(const T& candidate) {
+  return std::string_view(candidate);
+}
+template <class K, class V>
+std::string_view candidateName(const std::pair<K, V>& entry) {
+  return std::string_view(entry.first);
+}
+
 // The candidate closest to `word` when it is close enough to be a plausible typo (at most a third
 // of the longer word's letters differ, and at most 3), else empty.
 template <class Names>
@@ -48,7 +59,7 @@ std::string closestName(std::string_view word, const Names& candidates) {
   std::string best;
   std::size_t bestDistance = 0;
   for (const auto& candidate : candidates) {
-    const std::string_view name(candidate);
+    const std::string_view name = candidateName(candidate);
     const std::size_t limit = std::min<std::size_t>(3, std::max(word.size(), name.size()) / 3);
     // The distance is at least the difference in length: a candidate that far (every long one)
     // costs no distance matrix.
@@ -90,7 +101,7 @@ std::string undefinedNameHint(std::string_view word, const Map& defined, std::st
   if (defined.empty()) return std::string(none);
   if (hintsLeft > 0) {
     --hintsLeft;
-    std::string hint = didYouMean(word, std::views::keys(defined));
+    std::string hint = didYouMean(word, defined);
     if (!hint.empty()) return hint;
   }
   std::string hint = "; defined: ";
