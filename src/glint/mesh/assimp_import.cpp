@@ -191,7 +191,8 @@ void keepOnlyImporterFor(Assimp::Importer& importer, const std::string& extensio
 // Why a file the reader ran out of memory on is refused (kMeshReaderMemory*, import_child.h).
 constexpr std::string_view kNotEnoughMemory =
     "not enough memory to read it (the mesh reader may use 512 MiB plus 256 bytes per byte of the "
-    "file, and this file asks for more: damaged or malformed counts?)";
+    "file, and this file asks for more: damaged or malformed counts, or an OBJ whose material "
+    "libraries define tens of thousands of materials, ~26 KB each in the mesh library?)";
 static_assert(kMeshReaderMemoryBaseBytes == 512.0 * 1024 * 1024 &&
               kMeshReaderMemoryPerFileByte == 256);
 
