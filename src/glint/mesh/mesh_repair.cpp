@@ -207,17 +207,27 @@ class SimpleObjVertices {
   mutable std::vector<FirstUse> firstUse_;  // per position index
 };
 
-// The eight floats' bits (positions are finite here: triangles touching a non-finite vertex were
-// dropped) folded in pairs through the process's seeded hash (core/seeded_hash.h): a file cannot
-// be made of vertices that all land in a few slots of the joining table.
-std::uint64_t hashOf(const VertexKey& key, std::uint64_t seed) {
-  std::uint32_t bits[8];
-  std::memcpy(bits, key.p, 12);
-  std::memcpy(bits + 3, key.n, 12);
-  std::memcpy(bits + 6, key.t, 8);
+// Floats' bits folded two at a time (an odd last one alone) through the process's seeded hash
+// (core/seeded_hash.h): a file cannot be made of keys that all land in a few slots of a table.
+std::uint64_t hashFloatBits(const float* values, int count, std::uint64_t seed) {
   SeededHasher h(seed);
-  for (int i = 0; i < 8; i += 2) h.add(bits[i] | std::uint64_t{bits[i + 1]} << 32);
+  for (int i = 0; i < count; i += 2) {
+    std::uint32_t low = 0;
+    std::uint32_t high = 0;
+    std::memcpy(&low, values + i, 4);
+    if (i + 1 < count) std::memcpy(&high, values + i + 1, 4);
+    h.add(low | std::uint64_t{high} << 32);
+  }
   return h.value();
+}
+
+// The eight floats of a key (positions are finite here: triangles touching a non-finite vertex
+// were dropped).
+std::uint64_t hashOf(const VertexKey& key, std::uint64_t seed) {
+  float values[8];
+  static_assert(sizeof values == sizeof(VertexKey));
+  std::memcpy(values, &key, sizeof values);
+  return hashFloatBits(values, 8, seed);
 }
 
 }  // namespace
@@ -468,18 +478,11 @@ bool isFinite(const Double3& p) {
 // A position with −0 made +0: the two are one position (as keyOf and meshBoundsVolume take them).
 aiVector3D canonical(const aiVector3D& v) { return {v.x + 0.0f, v.y + 0.0f, v.z + 0.0f}; }
 
-// A hash of a float position's bits (−0 as +0), seeded (core/seeded_hash.h): a file cannot be made
-// of positions that all land in a few slots of the table below.
+// A hash of a float position's bits (−0 as +0).
 std::uint64_t positionHash(const aiVector3D& v, std::uint64_t seed) {
   const aiVector3D c = canonical(v);
-  std::uint32_t bits[3];
-  std::memcpy(bits, &c.x, 4);
-  std::memcpy(bits + 1, &c.y, 4);
-  std::memcpy(bits + 2, &c.z, 4);
-  SeededHasher h(seed);
-  h.add(bits[0] | std::uint64_t{bits[1]} << 32);
-  h.add(bits[2]);
-  return h.value();
+  const float values[3] = {c.x, c.y, c.z};
+  return hashFloatBits(values, 3, seed);
 }
 
 bool samePosition(const aiVector3D& a, const aiVector3D& b) {
