@@ -62,6 +62,10 @@ std::string nearestSupported(std::string_view word) {
 struct Camera {
   TextPosition at;
   bool orthographic = false;
+  // PROJECTION PERSPECTIVE_DOF: the distance in focus and the lens's f-number (FOCALDIST or
+  // FOCALLENGTH, then APERTURE), at the word PERSPECTIVE_DOF.
+  std::optional<TextPosition> depthOfField;
+  Number focalDistance, fNumber;
   Number zoom, aspect, antialiasing, raydepth;
   Triple center, viewdir, updir;
 };
@@ -189,9 +193,18 @@ class TachyonReader {
       const std::string m = upper(mode.text);
       if (m == "ORTHOGRAPHIC") {
         c.orthographic = true;
+      } else if (m == "PERSPECTIVE_DOF") {
+        // VMD writes FOCALDIST, Tachyon's manual FOCALLENGTH: both are the first value of
+        // Tachyon's rt_camera_dof (the distance in focus), APERTURE its second (the f-number).
+        c.depthOfField = mode.at;
+        const Token focal = in_.need(t, "FOCALDIST");
+        if (upper(focal.text) != "FOCALLENGTH") in_.expectWord(t, focal, "FOCALDIST");
+        c.focalDistance = in_.number(t, "focal distance");
+        in_.keyword(t, "APERTURE");
+        c.fNumber = in_.number(t, "aperture");
       } else if (m != "PERSPECTIVE") {
         out_.error(mode.at, fmt::format("camera projection {} is not supported (glint reads "
-                                        "PERSPECTIVE and ORTHOGRAPHIC)",
+                                        "PERSPECTIVE, PERSPECTIVE_DOF and ORTHOGRAPHIC)",
                                         quoteForMessage(mode.text)));
         throw SyntaxError{};
       }
@@ -229,6 +242,22 @@ class TachyonReader {
                                                 "got {}",
                                                 c.antialiasing.text));
       return;
+    }
+    if (c.depthOfField) {
+      for (const Number* n : {&c.focalDistance, &c.fNumber}) {
+        if (!(n->value > 0)) {
+          out_.error(n->at, fmt::format("camera: {} must be > 0, got {}",
+                                        n == &c.focalDistance ? "the focal distance" : "APERTURE",
+                                        n->text));
+          return;
+        }
+      }
+      if (c.antialiasing.value == 0) {
+        out_.warning(*c.depthOfField,
+                     "PERSPECTIVE_DOF with ANTIALIASING 0: Tachyon traces each pixel's one "
+                     "sample through the centre of the lens, so the image is sharp, and glint's "
+                     "is too (depth of field needs ANTIALIASING 1 or more)");
+      }
     }
     camera_ = c;
   }
@@ -497,6 +526,14 @@ class TachyonReader {
       out_.computedTriple("direction", direction, at);
     }
     if (c.orthographic) out_.entry("projection", "orthographic", c.at);
+    if (c.depthOfField && c.antialiasing.value > 0) {
+      // Tachyon's lens is a disc of radius FOCALDIST / (2 · APERTURE), the f-number raised to at
+      // least 0.01; glint's aperture is that radius. (Tachyon focuses at that distance along each
+      // ray, glint on the plane at that distance along the view direction.)
+      const double fNumber = std::max(c.fNumber.value, 0.01);
+      out_.entry("aperture", numberText(c.focalDistance.value / (2 * fNumber)), c.fNumber.at);
+      out_.entry("focus_distance", numberText(c.focalDistance.value), c.focalDistance.at);
+    }
     const double zoom = camera_ ? c.zoom.value : 1;
     const double aspect = camera_ ? c.aspect.value : 1;
     const double w = resolution_[0].value, h = resolution_[1].value;

@@ -283,6 +283,63 @@ TEST(TachyonReader, VmdAmbientOcclusionIsGlintsOnTheDiffuseColour) {
   EXPECT_FALSE(buildDescribedScene(offResult).parts.render.ambientOcclusion.has_value());
 }
 
+// PROJECTION PERSPECTIVE_DOF as VMD writes it (FOCALDIST, APERTURE as an f-number) and as Tachyon's
+// manual lists it (FOCALLENGTH): a thin lens of Tachyon's radius FOCALDIST / (2 · APERTURE)
+// focused at FOCALDIST; sharp with ANTIALIASING 0, as Tachyon draws it.
+TEST(TachyonReader, PerspectiveDofIsAThinLensOfTachyonsRadius) {
+  const auto scene = [](const std::string& projection, int antialiasing) {
+    return "Begin_Scene\nResolution 8 8\nCamera\n" + projection +
+           "\n  Zoom 1\n  Aspectratio 1\n  Antialiasing " + std::to_string(antialiasing) +
+           "\n  Raydepth 4\n  Center 0 0 -10\n  Viewdir 0 0 1\n  Updir 0 1 0\nEnd_Camera\n"
+           "Texdef a Ambient 0 Diffuse 1 Specular 0 Opacity 1 Color 1 0 0 TexFunc 0\n"
+           "Sphere Center 0 0 0 Rad 1 a\nEnd_Scene\n";
+  };
+  const ParseResult vmd = parseTachyon(
+      scene("  Projection Perspective_DoF\n  FocalDist 10\n  Aperture 2.5", 4), "vmd.dat");
+  ASSERT_FALSE(vmd.hasErrors()) << firstError(vmd);
+  EXPECT_TRUE(vmd.diagnostics.empty());
+  const Entity& camera = nth(vmd, EntityKind::CameraEntity, 0);
+  const SceneDescription& d = vmd.description;
+  EXPECT_EQ(d.text(camera, d.parameter(camera, "aperture")), "2");
+  EXPECT_EQ(d.text(camera, d.parameter(camera, "focus_distance")), "10");
+  const LoadedScene loaded = buildDescribedScene(vmd);
+  EXPECT_EQ(loaded.parts.camera.aperture, 2.0);
+  EXPECT_EQ(loaded.parts.camera.focusDistance, 10.0);
+  EXPECT_EQ(loaded.parts.camera.viewPlaneHeight, 1.0);  // the field of view is unchanged
+  EXPECT_EQ(loaded.parts.image.samples, 5);
+
+  // The manual's keyword, and an f-number below Tachyon's least (0.01).
+  const ParseResult manual = parseTachyon(
+      scene("  PROJECTION PERSPECTIVE_DOF FOCALLENGTH 0.75 APERTURE 0.001", 8), "manual.dat");
+  ASSERT_FALSE(manual.hasErrors()) << firstError(manual);
+  const LoadedScene wide = buildDescribedScene(manual);
+  EXPECT_EQ(wide.parts.camera.aperture, 0.75 / 0.02);
+  EXPECT_EQ(wide.parts.camera.focusDistance, 0.75);
+
+  // One sample per pixel: Tachyon's goes through the lens centre; a warning says so.
+  const ParseResult sharp =
+      parseTachyon(scene("Projection Perspective_DoF FocalDist 10 Aperture 2.5", 0), "sharp.dat");
+  ASSERT_FALSE(sharp.hasErrors()) << firstError(sharp);
+  ASSERT_EQ(sharp.diagnostics.size(), 1u);
+  EXPECT_EQ(sharp.diagnostics[0].format(),
+            "sharp.dat:4:12: warning: PERSPECTIVE_DOF with ANTIALIASING 0: Tachyon traces each "
+            "pixel's one sample through the centre of the lens, so the image is sharp, and "
+            "glint's is too (depth of field needs ANTIALIASING 1 or more)");
+  EXPECT_EQ(buildDescribedScene(sharp).parts.camera.aperture, 0.0);
+
+  EXPECT_EQ(firstError(parseTachyon(scene("Projection Perspective_DoF FocalDist -1 Aperture 2", 4),
+                                    "bad.dat")),
+            "bad.dat:4:38: camera: the focal distance must be > 0, got -1");
+  EXPECT_EQ(firstError(parseTachyon(scene("Projection Perspective_DoF FocalDist 1 Aperture 0", 4),
+                                    "bad.dat")),
+            "bad.dat:4:49: camera: APERTURE must be > 0, got 0");
+  EXPECT_EQ(firstError(parseTachyon(scene("Projection Perspective_DoF Zoom 1", 4), "bad.dat")),
+            "bad.dat:4:28: Camera: expected FOCALDIST, got 'Zoom'");
+  EXPECT_EQ(firstError(parseTachyon(scene("Projection Fisheye", 4), "bad.dat")),
+            "bad.dat:4:12: camera projection 'Fisheye' is not supported (glint reads PERSPECTIVE, "
+            "PERSPECTIVE_DOF and ORTHOGRAPHIC)");
+}
+
 // Tachyon finds a texture name's first definition: a TEXDEF of a name already defined changes
 // nothing (a warning says so).
 TEST(TachyonReader, ATexdefOfADefinedNameKeepsTheFirst) {
