@@ -22,6 +22,7 @@
 #include "glint/factories/scene_loader.h"
 #include "glint/job/job_error.h"
 #include "glint/job/scene_convert.h"
+#include "glint/mesh/mesh_file.h"
 #include "glint/readers/nff_reader.h"
 #include "glint/readers/tachyon_reader.h"
 #include "glint/render/renderer.h"
@@ -491,6 +492,24 @@ TEST(QuickLook, FramesTheModelWithLightsAndGround) {
   EXPECT_GT(toCamera.x, 0);
   EXPECT_GT(toCamera.y, 0);
   EXPECT_GT(toCamera.z, 0);
+}
+
+// The quick look reads its model once: to frame it, and the scene's mesh object takes that read
+// (the file may be gone by the time the scene is built).
+TEST(QuickLook, ReadsTheModelOnce) {
+  const fs::path folder = fs::temp_directory_path() / fmt::format("glint-quick-{}", ::getpid());
+  fs::create_directories(folder);
+  const fs::path model = folder / "knot.obj";
+  fs::copy_file(fs::path(GLINT_SOURCE_DIR) / "scenes" / "meshes" / "torus_knot.obj", model,
+                fs::copy_options::overwrite_existing);
+  const ParseResult described = describeSceneFile(model);
+  ASSERT_EQ(described.description.readMeshFiles.size(), 1u);
+  fs::remove_all(folder);
+  const LoadedScene loaded = buildDescribedScene(described);
+  ASSERT_EQ(loaded.parts.meshes.size(), 1u);
+  EXPECT_EQ(loaded.parts.meshes[0].triangleCount(),
+            described.description.readMeshFiles[0].second->triangleCount());
+  EXPECT_EQ(loaded.parts.meshes[0].triangleCount(), 38400u);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <string>
 
@@ -52,9 +53,10 @@ ParseResult describeQuickLook(const std::filesystem::path& file, const LoadOptio
   const std::string name = file.string();
   std::filesystem::path base = file.parent_path();
   if (base.empty()) base = ".";
-  MeshFile mesh;
+  std::shared_ptr<const MeshFile> read;
   try {
-    mesh = readMeshFile(file, MeshReadOptions{.sceneFolder = base, .cancel = options.cancel});
+    read = std::make_shared<const MeshFile>(
+        readMeshFile(file, MeshReadOptions{.sceneFolder = base, .cancel = options.cancel}));
   } catch (const MeshLoadError& e) {
     // At the line and column in the file when the reason names them.
     if (const std::optional<MeshErrorPlace> place = meshErrorPlace(e.what())) {
@@ -67,7 +69,7 @@ ParseResult describeQuickLook(const std::filesystem::path& file, const LoadOptio
                        fmt::format("cannot load mesh file: {}", e.what())}});
   }
   Bounds3 bounds;
-  for (const TriangleMesh& part : mesh.parts) {
+  for (const TriangleMesh& part : read->parts) {
     for (const Point3& p : part.positions) bounds = unite(bounds, p);
   }
   const Point3 center = bounds.centroid();
@@ -79,6 +81,8 @@ ParseResult describeQuickLook(const std::filesystem::path& file, const LoadOptio
   result.description = sceneWithFile(name, base);
   SceneDescription& scene = result.description;
   scene.files[0]->bytes = std::filesystem::file_size(file);
+  // The builder's mesh object names the file by its name in `base`: the same file, not read again.
+  scene.readMeshFiles.emplace_back(base / file.filename(), read);
   Diagnostics sink;
   SceneEmitter out(scene, sink);
 

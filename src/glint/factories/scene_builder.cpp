@@ -64,6 +64,7 @@ class Builder {
                  meshCache_.meshBytes();
         }) {
     ctx_.textures = &textures_;
+    for (const auto& [path, file] : description.readMeshFiles) meshCache_.adopt(path, file);
     for (const ObjectFactory& f : objectFactories()) objectTypes_.push_back(f.type);
     objectTypes_.push_back(csgFactory_.type);
     objectTypes_.push_back(kInstanceFactory.type);

@@ -43,6 +43,11 @@ std::shared_ptr<const MeshFile> MeshCache::read(const std::filesystem::path& key
   }
 }
 
+void MeshCache::adopt(const std::filesystem::path& path, std::shared_ptr<const MeshFile> file) {
+  if (!file) return;
+  entries_.try_emplace(keyOf(path), Entry{std::move(file), {}, false});
+}
+
 std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& path,
                                                 const MeshReadOptions& options) {
   throwIfCancelled(options.cancel);
@@ -56,12 +61,15 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
   const std::filesystem::path key = keyOf(path);
   const auto it = entries_.find(key);
   if (it != entries_.end() && !it->second.file) throw MeshLoadError(it->second.error);
-  const bool cached = it != entries_.end();
+  // present: no estimate needed (read, or adopted with its real sizes); cached: its own copy is
+  // counted already.
+  const bool present = it != entries_.end();
+  const bool cached = present && it->second.counted;
   // An OBJ or STL whose size alone shows that no estimate could exceed the budget is not scanned
   // (a 100k-triangle OBJ: ~10 ms saved). A file that cannot be read fails in read() instead.
   bool bounded = false;
   const std::string ext = lowerExtension(path);
-  if (!cached && (ext == ".obj" || ext == ".stl")) {
+  if (!present && (ext == ".obj" || ext == ".stl")) {
     const ReadableFile file = statForReading(path);
     if (file.refusal == FileRefusal::None) {
       const double bound =
@@ -70,7 +78,7 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
                 static_cast<double>(budget.limit);
     }
   }
-  if (!cached && !bounded) {
+  if (!present && !bounded) {
     MeshSizeEstimate size;
     try {
       size = estimateMeshSize(path, options);
@@ -124,6 +132,7 @@ std::shared_ptr<const MeshFile> MeshCache::load(const std::filesystem::path& pat
         formatBytes(static_cast<double>(budget.limit))));
   }
   meshBytes_ += bytes;
+  entries_[key].counted = true;
   return file;
 }
 

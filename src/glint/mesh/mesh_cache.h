@@ -83,7 +83,11 @@ class MeshCache {
   // remembered: the file itself is fine) or MeshLoadError.
   std::shared_ptr<const MeshFile> load(const std::filesystem::path& path, const MeshBudget& budget,
                                        const MeshReadOptions& options = {});
-  // Files actually read (not served from the cache).
+  // Takes `file` as the content of `path`, read elsewhere (the quick look's reader): later loads
+  // are served from it. The first load with a budget counts it as a fresh read (its copy, the
+  // world copy and the BVH build), without the estimate's scan. Ignored when the file is cached.
+  void adopt(const std::filesystem::path& path, std::shared_ptr<const MeshFile> file);
+  // Files actually read (not served from the cache or adopted).
   std::size_t filesRead() const { return filesRead_; }
   // Estimated bytes of every mesh loaded with a budget so far: cached files, world copies, BVH
   // build.
@@ -92,7 +96,8 @@ class MeshCache {
  private:
   struct Entry {
     std::shared_ptr<const MeshFile> file;
-    std::string error;  // when file is null
+    std::string error;    // when file is null
+    bool counted = true;  // false for an adopted file no budgeted load has counted yet
   };
   static std::filesystem::path keyOf(const std::filesystem::path& path);
   std::shared_ptr<const MeshFile> read(const std::filesystem::path& key,

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "glint/mesh/mesh_size_estimate.h"
@@ -125,6 +126,20 @@ TEST(MeshCache, TheMemoryEstimateRefusesBeforeReadingAndCountsEveryInstance) {
   EXPECT_EQ(cache.load(obj, MeshBudget{224192 + 164096, 0}), file);
   EXPECT_DOUBLE_EQ(cache.meshBytes(), 224192 + 164096);
   EXPECT_EQ(cache.filesRead(), 1u);
+
+  // A file read elsewhere (the quick look) and adopted is not read again, and its first budgeted
+  // load counts as a fresh read: the same bytes, the same limit.
+  MeshCache adopting;
+  adopting.adopt(obj, file);
+  EXPECT_THROW(adopting.load(obj, MeshBudget{300000, 75809}), MeshTooLargeError);
+  EXPECT_EQ(adopting.load(obj, MeshBudget{300000, 75808}), file);
+  EXPECT_DOUBLE_EQ(adopting.meshBytes(), 224192);
+  EXPECT_EQ(adopting.load(obj, MeshBudget{224192 + 164096, 0}), file);
+  EXPECT_DOUBLE_EQ(adopting.meshBytes(), 224192 + 164096);
+  EXPECT_EQ(adopting.filesRead(), 0u);
+  // Adopting a file the cache holds already changes nothing.
+  adopting.adopt(obj, std::make_shared<const MeshFile>());
+  EXPECT_EQ(adopting.load(obj), file);
 }
 
 }  // namespace

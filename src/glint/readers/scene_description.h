@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "glint/readers/diagnostics.h"
@@ -18,6 +19,8 @@
 #include "glint/readers/value_tree.h"
 
 namespace glint {
+
+struct MeshFile;  // mesh/mesh_file.h
 
 enum class EntityKind : std::uint8_t {
   CameraEntity,
@@ -59,6 +62,9 @@ struct SceneDescription {
   std::vector<Entity> entities;                    // in file order
   ValueId name = kNoValue;                         // the top-level `name` (in files[0])
   bool complete = true;                            // false when the reader reported an error
+  // Mesh files the reader has read already (the quick look reads its model to frame it), by the
+  // path it read: the builder takes them as read instead of reading them again.
+  std::vector<std::pair<std::filesystem::path, std::shared_ptr<const MeshFile>>> readMeshFiles;
 
   // A new file; its index is files.size() - 1.
   SourceFile& addFile(std::string fileName, std::filesystem::path baseDirectory);
