@@ -23,6 +23,7 @@
 #include "glint/job/job_error.h"
 #include "glint/job/scene_convert.h"
 #include "glint/mesh/mesh_file.h"
+#include "glint/mesh/mesh_test_support.h"
 #include "glint/readers/nff_reader.h"
 #include "glint/readers/tachyon_reader.h"
 #include "glint/render/renderer.h"
@@ -492,6 +493,23 @@ TEST(QuickLook, FramesTheModelWithLightsAndGround) {
   EXPECT_GT(toCamera.x, 0);
   EXPECT_GT(toCamera.y, 0);
   EXPECT_GT(toCamera.z, 0);
+}
+
+// Triangles assimp's glTF reader leaves out for an index out of range are not silent: a warning
+// at the mesh object says so.
+TEST(QuickLook, FacesTheMeshLibraryDropsAreAWarning) {
+  const mesh_test::TempDir dir;
+  const LoadedScene clean = loadScene(mesh_test::writeQuadGltf(dir, 3));
+  EXPECT_TRUE(clean.warnings.empty());
+  const LoadedScene dropped = loadScene(mesh_test::writeQuadGltf(dir, 7));
+  ASSERT_EQ(dropped.parts.meshes.size(), 1u);
+  EXPECT_EQ(dropped.parts.meshes[0].triangleCount(), 2u);
+  ASSERT_EQ(dropped.warnings.size(), 1u);
+  EXPECT_THAT(
+      dropped.warnings[0].format(),
+      testing::HasSubstr("warning: mesh file 'quad7.gltf': the mesh library left out faces whose "
+                         "vertex indices are out of range (it does not say how many); 2 triangles "
+                         "remain"));
 }
 
 // The quick look reads its model once: to frame it, and the scene's mesh object takes that read

@@ -590,6 +590,12 @@ class Builder {
                                 named, file->droppedTriangles,
                                 file->droppedTriangles == 1 ? "" : "s", triangles));
     }
+    if (file->importerDroppedFaces) {
+      sink_.warning(params.location(),
+                    fmt::format("{}: the mesh library left out faces whose vertex indices are "
+                                "out of range (it does not say how many); {} triangle{} remain",
+                                named, triangles, triangles == 1 ? "" : "s"));
+    }
     // (With `smooth: false` the generated normals are not used.)
     if (file->exactPositionNormalParts > 0 && request.smooth) {
       sink_.warning(

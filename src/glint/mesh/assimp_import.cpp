@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <optional>
 #include <set>
@@ -29,8 +30,10 @@
 #include <assimp/scene.h>
 #include <assimp/texture.h>
 #include <fmt/format.h>
+#include <assimp/DefaultLogger.hpp>
 #include <assimp/IOStream.hpp>
 #include <assimp/Importer.hpp>
+#include <assimp/LogStream.hpp>
 
 #include "glint/core/file_access.h"
 #include "glint/mesh/import_child.h"
@@ -414,6 +417,43 @@ class SimpleObjImporter : public Assimp::BaseImporter {
   const SimpleObj& obj_;  // outlives the importer (importScene's caller holds it)
 };
 
+// Faces assimp's glTF readers drop for a vertex index out of range: they say so only in a warning
+// of their logger, without a count. While a file is read this stream watches the warnings for
+// that sentence (assimp 5.2's wording), so that the drop is not silent.
+class DroppedFacesWatch : public Assimp::LogStream {
+ public:
+  void write(const char* message) override {
+    if (std::string_view(message).find("faces had out-of-range indices") != std::string_view::npos)
+      seen = true;
+  }
+  bool seen = false;
+};
+
+// Attaches a DroppedFacesWatch to assimp's logger, a process-wide singleton, for one ReadFile:
+// one read at a time in a process (the reader program reads one file; tests read in turn).
+class WatchedRead {
+ public:
+  WatchedRead() : lock_(mutex()) {
+    Assimp::DefaultLogger::create(nullptr, Assimp::Logger::NORMAL, 0);
+    Assimp::DefaultLogger::get()->attachStream(&watch_, Assimp::Logger::Warn);
+  }
+  ~WatchedRead() {
+    Assimp::DefaultLogger::get()->detachStream(&watch_, Assimp::Logger::Warn);
+    Assimp::DefaultLogger::kill();
+  }
+  WatchedRead(const WatchedRead&) = delete;
+  WatchedRead& operator=(const WatchedRead&) = delete;
+  bool droppedFaces() const { return watch_.seen; }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  DroppedFacesWatch watch_;
+};
+
 // importMesh with assimp's importer for `extension`, or with SimpleObjImporter alone for
 // `simpleObj` when given.
 MeshFile importScene(const std::filesystem::path& path, const std::string& extension,
@@ -445,7 +485,12 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
   MeshFile result;
   try {
     // Read without post-processing first: the faces are checked before any step indexes with them.
-    const aiScene* scene = importer.ReadFile(path.string(), 0);
+    const aiScene* scene = nullptr;
+    {
+      const WatchedRead watched;
+      scene = importer.ReadFile(path.string(), 0);
+      result.importerDroppedFaces = watched.droppedFaces();
+    }
     if (!files->refusal().empty()) throw MeshLoadError(files->refusal());
     if (scene == nullptr) throw MeshLoadError(assimpReason(importer.GetErrorString()));
     std::optional<std::set<std::string>> objDefined;

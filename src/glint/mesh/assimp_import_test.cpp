@@ -3,6 +3,7 @@
 // counts, bounds and materials the tests read from the files themselves.
 #include "glint/mesh/assimp_import.h"
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -415,6 +416,22 @@ TEST(MeshImport, NonFiniteVerticesAreDroppedNotFatal) {
     }
   } catch (const MeshLoadError& e) {
     EXPECT_THAT(e.what(), HasSubstr("degenerate"));  // every triangle touched an infinity
+  }
+}
+
+// assimp's glTF reader leaves out a triangle with a vertex index out of range and says so only in
+// its log, without a count; glint notes it (importerDroppedFaces, a warning at the mesh object).
+TEST(MeshImport, GltfFacesTheImporterDropsAreNoted) {
+  const TempDir dir;
+  for (const std::uint16_t last : {std::uint16_t{3}, std::uint16_t{7}}) {
+    const MeshFile file = readMeshFile(writeQuadGltf(dir, last));
+    if (last == 3) {
+      EXPECT_EQ(file.triangleCount(), 3u);
+      EXPECT_FALSE(file.importerDroppedFaces);
+    } else {
+      EXPECT_EQ(file.triangleCount(), 2u);
+      EXPECT_TRUE(file.importerDroppedFaces);
+    }
   }
 }
 

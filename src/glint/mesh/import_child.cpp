@@ -156,6 +156,7 @@ MeshFile receiveMeshFile(Reader& in) {
   if (tag != 'M') throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
   MeshFile file;
   file.droppedTriangles = static_cast<std::size_t>(in.value<std::uint64_t>());
+  file.importerDroppedFaces = in.value<std::uint64_t>() != 0;
   file.exactPositionNormalParts = static_cast<std::size_t>(in.value<std::uint64_t>());
   file.crowdedNormalPositions = static_cast<std::size_t>(in.value<std::uint64_t>());
   file.ignoredTextures.resize(static_cast<std::size_t>(in.count(kMaxIgnoredTextures)));

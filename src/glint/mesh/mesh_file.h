@@ -134,6 +134,9 @@ struct MeshFile {
   // edge², the same bound as a scene's triangle), a non-finite vertex, or a vertex index out of
   // range.
   std::size_t droppedTriangles = 0;
+  // The importer itself left out faces with a vertex index out of range, without a count
+  // (assimp's glTF readers): reported in a warning.
+  bool importerDroppedFaces = false;
   // Textures the materials name that glint does not use, as "map_Ka 'wood.png'" (an OBJ's
   // ambient, opacity, shininess, reflection and displacement maps): reported in a warning.
   std::vector<std::string> ignoredTextures;  // at most kMaxIgnoredTextures

@@ -29,6 +29,7 @@ namespace wire {
 
 bool writeMeshFile(int fd, const MeshFile& file) {
   bool ok = writeValue(fd, 'M') && writeValue(fd, std::uint64_t{file.droppedTriangles}) &&
+            writeValue(fd, std::uint64_t{file.importerDroppedFaces ? 1u : 0u}) &&
             writeValue(fd, std::uint64_t{file.exactPositionNormalParts}) &&
             writeValue(fd, std::uint64_t{file.crowdedNormalPositions}) &&
             writeValue(fd, std::uint64_t{file.ignoredTextures.size()});

@@ -17,7 +17,7 @@
 namespace glint::wire {
 
 // The first argument of the reader program: a reader from another glint build refuses to answer.
-inline constexpr const char* kMeshReaderProtocol = "glint-mesh-reader/" GLINT_VERSION "/3";
+inline constexpr const char* kMeshReaderProtocol = "glint-mesh-reader/" GLINT_VERSION "/4";
 
 // Writes everything or stops silently (the parent sees a short message).
 inline bool writeAll(int fd, const void* data, std::size_t size) {
@@ -48,8 +48,9 @@ inline bool writeMessage(int fd, char tag, const std::string& text) {
          writeAll(fd, text.data(), text.size());
 }
 
-// The whole answer: 'M', the dropped triangles, the generated normals' two counts
-// (exactPositionNormalParts, crowdedNormalPositions), the textures the materials name that glint
+// The whole answer: 'M', the dropped triangles, whether the importer dropped faces itself (0 or
+// 1), the generated normals' two counts (exactPositionNormalParts, crowdedNormalPositions), the
+// textures the materials name that glint
 // does not use, then the file's materials, embedded images and parts.
 bool writeMeshFile(int fd, const MeshFile& file);
 

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -68,6 +69,28 @@ class TempDir {
  private:
   fs::path path_;
 };
+
+// A glTF quad (two triangles) and a third triangle 0, 1, lastIndex over its four vertices:
+// lastIndex 3 is valid, 4 or more out of range (assimp's glTF reader then drops that triangle).
+// Positions and 16-bit indices in a .bin beside the .gltf; returns the .gltf's path.
+inline fs::path writeQuadGltf(const TempDir& dir, std::uint16_t lastIndex) {
+  const std::string name = "quad" + std::to_string(lastIndex);
+  const float positions[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  const std::uint16_t indices[10] = {0, 1, 2, 1, 3, 2, 0, 1, lastIndex, 0};
+  std::string bytes(sizeof positions + sizeof indices, '\0');
+  std::memcpy(bytes.data(), positions, sizeof positions);
+  std::memcpy(bytes.data() + sizeof positions, indices, sizeof indices);
+  dir.write(name + ".bin", bytes);
+  return dir.write(
+      name + ".gltf",
+      R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+"meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+"buffers": [{"byteLength": 68, "uri": ")" +
+          name + R"(.bin"}],
+"bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 18}],
+"accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+  {"bufferView": 1, "componentType": 5123, "count": 9, "type": "SCALAR"}]})");
+}
 
 inline Bounds3 boundsOf(const std::vector<TriangleMesh>& parts) {
   Bounds3 b;
