@@ -85,7 +85,8 @@ class MeshCache {
                                        const MeshReadOptions& options = {});
   // Takes `file` as the content of `path`, read elsewhere (the quick look's reader): later loads
   // are served from it. The first load with a budget counts it as a fresh read (its copy, the
-  // world copy and the BVH build), without the estimate's scan. Ignored when the file is cached.
+  // world copy and the BVH build) from its real sizes, without the estimate (which can exceed
+  // them: unused vertices); ignored when the file is cached.
   void adopt(const std::filesystem::path& path, std::shared_ptr<const MeshFile> file);
   // Files actually read (not served from the cache or adopted).
   std::size_t filesRead() const { return filesRead_; }

@@ -128,7 +128,7 @@ TEST(MeshCache, TheMemoryEstimateRefusesBeforeReadingAndCountsEveryInstance) {
   EXPECT_EQ(cache.filesRead(), 1u);
 
   // A file read elsewhere (the quick look) and adopted is not read again, and its first budgeted
-  // load counts as a fresh read: the same bytes, the same limit.
+  // load counts as a fresh read from its real sizes (here equal to the estimate).
   MeshCache adopting;
   adopting.adopt(obj, file);
   EXPECT_THROW(adopting.load(obj, MeshBudget{300000, 75809}), MeshTooLargeError);
@@ -140,6 +140,19 @@ TEST(MeshCache, TheMemoryEstimateRefusesBeforeReadingAndCountsEveryInstance) {
   // Adopting a file the cache holds already changes nothing.
   adopting.adopt(obj, std::make_shared<const MeshFile>());
   EXPECT_EQ(adopting.load(obj), file);
+
+  // Where the estimate exceeds the real sizes (1000 vertices no face uses), an adopted file is
+  // checked by its real sizes only, a file not yet read by the estimate first.
+  std::string unused;
+  for (int i = 0; i < 1000; ++i) unused += fmt::format("v {} 0 0\n", i);
+  const fs::path sparse =
+      dir.write("sparse.obj", unused + "v 0 0 1\nv 0 1 1\nv 1 0 1\nf 1001 1002 1003\n");
+  const MeshBudget tight{static_cast<std::uint64_t>(meshCopyBytes(1, 3) + meshInstanceBytes(1, 3)),
+                         0};
+  EXPECT_THROW(MeshCache().load(sparse, tight), MeshTooLargeError);
+  MeshCache quickLook;
+  quickLook.adopt(sparse, MeshCache().load(sparse));
+  ASSERT_EQ(quickLook.load(sparse, tight)->parts[0].positions.size(), 3u);
 }
 
 }  // namespace

@@ -70,6 +70,12 @@ struct Camera {
   Triple center, viewdir, updir;
 };
 
+// Tachyon's lens (rt_camera_dof) is a disc of radius FOCALDIST / (2 · APERTURE), the f-number
+// raised to at least 0.01; glint's `aperture` is that radius.
+double lensRadius(const Camera& c) {
+  return c.focalDistance.value / (2 * std::max(c.fNumber.value, 0.01));
+}
+
 class TachyonReader {
  public:
   TachyonReader(std::string_view text, SceneEmitter& out, const std::atomic<bool>* cancel)
@@ -198,7 +204,12 @@ class TachyonReader {
         // Tachyon's rt_camera_dof (the distance in focus), APERTURE its second (the f-number).
         c.depthOfField = mode.at;
         const Token focal = in_.need(t, "FOCALDIST");
-        if (upper(focal.text) != "FOCALLENGTH") in_.expectWord(t, focal, "FOCALDIST");
+        const std::string f = upper(focal.text);
+        if (f != "FOCALDIST" && f != "FOCALLENGTH") {
+          out_.error(focal.at, fmt::format("{}: expected FOCALDIST or FOCALLENGTH, got {}", t.text,
+                                           quoteForMessage(focal.text)));
+          throw SyntaxError{};
+        }
         c.focalDistance = in_.number(t, "focal distance");
         in_.keyword(t, "APERTURE");
         c.fNumber = in_.number(t, "aperture");
@@ -230,35 +241,40 @@ class TachyonReader {
       throw SyntaxError{};
     }
     in_.expectWord(t, end, "END_CAMERA");
+    bool valid = true;  // every error of the statement is reported
     for (const Number* n : {&c.zoom, &c.aspect}) {
       if (!(n->value > 0)) {
         out_.error(n->at, fmt::format("camera: {} must be > 0, got {}",
                                       n == &c.zoom ? "ZOOM" : "ASPECTRATIO", n->text));
-        return;
+        valid = false;
       }
     }
     if (!(c.antialiasing.value >= 0 && c.antialiasing.value == std::floor(c.antialiasing.value))) {
       out_.error(c.antialiasing.at, fmt::format("camera: ANTIALIASING must be a whole number >= 0, "
                                                 "got {}",
                                                 c.antialiasing.text));
-      return;
+      valid = false;
     }
     if (c.depthOfField) {
+      bool lens = true;
       for (const Number* n : {&c.focalDistance, &c.fNumber}) {
         if (!(n->value > 0)) {
           out_.error(n->at, fmt::format("camera: {} must be > 0, got {}",
                                         n == &c.focalDistance ? "the focal distance" : "APERTURE",
                                         n->text));
-          return;
+          lens = false;
         }
       }
-      if (c.antialiasing.value == 0) {
-        out_.warning(*c.depthOfField,
-                     "PERSPECTIVE_DOF with ANTIALIASING 0: Tachyon traces each pixel's one "
-                     "sample through the centre of the lens, so the image is sharp, and glint's "
-                     "is too (depth of field needs ANTIALIASING 1 or more)");
+      if (lens && !std::isfinite(lensRadius(c))) {
+        out_.error(c.focalDistance.at,
+                   fmt::format("camera: the lens radius, focal distance / (2 · APERTURE) = {} / (2 "
+                               "· {}), is too large for a number",
+                               c.focalDistance.text, c.fNumber.text));
+        lens = false;
       }
+      valid = valid && lens;
     }
+    if (!valid) return;
     camera_ = c;
   }
 
@@ -526,12 +542,15 @@ class TachyonReader {
       out_.computedTriple("direction", direction, at);
     }
     if (c.orthographic) out_.entry("projection", "orthographic", c.at);
-    if (c.depthOfField && c.antialiasing.value > 0) {
-      // Tachyon's lens is a disc of radius FOCALDIST / (2 · APERTURE), the f-number raised to at
-      // least 0.01; glint's aperture is that radius. (Tachyon focuses at that distance along each
-      // ray, glint on the plane at that distance along the view direction.)
-      const double fNumber = std::max(c.fNumber.value, 0.01);
-      out_.entry("aperture", numberText(c.focalDistance.value / (2 * fNumber)), c.fNumber.at);
+    if (c.depthOfField && c.antialiasing.value == 0) {
+      out_.warning(*c.depthOfField,
+                   "PERSPECTIVE_DOF with ANTIALIASING 0: Tachyon traces each pixel's one sample "
+                   "through the centre of the lens, so the image is sharp, and glint's is too "
+                   "(depth of field needs ANTIALIASING 1 or more)");
+    } else if (c.depthOfField) {
+      // (Tachyon focuses at the distance along each ray, glint on the plane at that distance
+      // along the view direction.)
+      out_.entry("aperture", numberText(lensRadius(c)), c.fNumber.at);
       out_.entry("focus_distance", numberText(c.focalDistance.value), c.focalDistance.at);
     }
     const double zoom = camera_ ? c.zoom.value : 1;

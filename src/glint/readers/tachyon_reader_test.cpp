@@ -334,7 +334,27 @@ TEST(TachyonReader, PerspectiveDofIsAThinLensOfTachyonsRadius) {
                                     "bad.dat")),
             "bad.dat:4:49: camera: APERTURE must be > 0, got 0");
   EXPECT_EQ(firstError(parseTachyon(scene("Projection Perspective_DoF Zoom 1", 4), "bad.dat")),
-            "bad.dat:4:28: Camera: expected FOCALDIST, got 'Zoom'");
+            "bad.dat:4:28: Camera: expected FOCALDIST or FOCALLENGTH, got 'Zoom'");
+  // Every error of the camera, and a lens radius past the doubles named in the file's terms.
+  const ParseResult both =
+      parseTachyon(scene("Projection Perspective_DoF FocalDist -1 Aperture -2", 4), "bad.dat");
+  ASSERT_EQ(both.diagnostics.size(), 2u);
+  EXPECT_EQ(both.diagnostics[1].format(), "bad.dat:4:50: camera: APERTURE must be > 0, got -2");
+  EXPECT_EQ(firstError(parseTachyon(
+                scene("Projection Perspective_DoF FocalDist 1e308 Aperture 0.001", 4), "bad.dat")),
+            "bad.dat:4:38: camera: the lens radius, focal distance / (2 · APERTURE) = 1e308 / (2 · "
+            "0.001), is too large for a number");
+  // The warning is about the camera in effect: a later CAMERA replaces the first.
+  const std::string twoCameras = scene("Projection Perspective_DoF FocalDist 10 Aperture 2.5", 0);
+  const std::string plain =
+      "Camera\n  Zoom 1\n  Aspectratio 1\n  Antialiasing 0\n  Raydepth 4\n"
+      "  Center 0 0 -10\n  Viewdir 0 0 1\n  Updir 0 1 0\nEnd_Camera\n";
+  const ParseResult replaced =
+      parseTachyon(twoCameras.substr(0, twoCameras.find("Texdef")) + plain +
+                       twoCameras.substr(twoCameras.find("Texdef")),
+                   "two.dat");
+  ASSERT_FALSE(replaced.hasErrors()) << firstError(replaced);
+  EXPECT_TRUE(replaced.diagnostics.empty());
   EXPECT_EQ(firstError(parseTachyon(scene("Projection Fisheye", 4), "bad.dat")),
             "bad.dat:4:12: camera projection 'Fisheye' is not supported (glint reads PERSPECTIVE, "
             "PERSPECTIVE_DOF and ORTHOGRAPHIC)");
