@@ -903,6 +903,12 @@ TEST_F(Cli, MaxMemoryWithABadSizeIsAnArgumentError) {
     EXPECT_EQ(r.status, 2) << size;
     EXPECT_TRUE(contains(r.err, "--max-memory")) << size << ": " << r.err;
   }
+  // A fraction of a byte is a unit left out, not 2 bytes.
+  const RunResult fraction = run({"render", small(), "-o", "out.png", "--max-memory", "2.5"});
+  EXPECT_EQ(fraction.status, 2);
+  EXPECT_TRUE(contains(fraction.err, "--max-memory 2.5: a number of bytes must be whole (a size "
+                                     "with a unit may have a fraction: 2.5G, 2.5M)"))
+      << fraction.err;
   EXPECT_TRUE(filesIn(work_).empty());
 }
 

@@ -164,6 +164,12 @@ std::uint64_t parseMemorySize(const std::string& text) {
     if (power == std::string_view::npos || !(suffix.empty() || suffix == "B" || suffix == "IB"))
       throw bad();
     scale = std::pow(1024.0, static_cast<double>(power + 1));
+  } else if (number != std::floor(number)) {
+    // "2.5" is no number of bytes; most likely a unit was left out.
+    throw CliError(kExitBadInput,
+                   fmt::format("--max-memory {}: a number of bytes must be whole (a size with a "
+                               "unit may have a fraction: {}G, {}M)",
+                               text, rest.substr(0, digits), rest.substr(0, digits)));
   }
   const double bytes = std::floor(number * scale);
   // 2^64 is exactly representable; anything from it up does not fit.
