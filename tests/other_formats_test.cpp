@@ -512,6 +512,18 @@ TEST(QuickLook, FacesTheMeshLibraryDropsAreAWarning) {
                          "remain"));
 }
 
+// An OBJ's material library that is not there is a warning, not a silent grey.
+TEST(QuickLook, AMissingMaterialLibraryIsAWarning) {
+  const mesh_test::TempDir dir;
+  const LoadedScene loaded = loadScene(dir.write(
+      "knot.obj", "mtllib knot-copper.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl copper\nf 1 2 3\n"));
+  ASSERT_EQ(loaded.warnings.size(), 1u);
+  EXPECT_THAT(loaded.warnings[0].format(),
+              testing::HasSubstr("warning: mesh file 'knot.obj': its material library "
+                                 "'knot-copper.mtl' is not there: the faces of its materials get "
+                                 "the default material"));
+}
+
 // The quick look reads its model once: to frame it, and the scene's mesh object takes that read
 // (the file may be gone by the time the scene is built).
 TEST(QuickLook, ReadsTheModelOnce) {

@@ -614,6 +614,19 @@ class Builder {
                                 named, file->crowdedNormalPositions,
                                 file->crowdedNormalPositions == 1 ? "" : "s", kMaxSmoothedCorners));
     }
+    for (const std::string& library : file->missingMaterialLibraries) {
+      // The reader's text: not trusted.
+      sink_.warning(
+          params.location(),
+          file->fallbackMaterialLibrary.empty()
+              ? fmt::format("{}: its material library '{}' is not there: the faces of its "
+                            "materials get the default material",
+                            named, shortenForMessage(library))
+              : fmt::format("{}: its material library '{}' is not there; the materials come from "
+                            "'{}' beside it (the OBJ's own name), as the mesh library reads it",
+                            named, shortenForMessage(library),
+                            shortenForMessage(file->fallbackMaterialLibrary)));
+    }
     if (!file->ignoredTextures.empty()) {
       std::vector<std::string> ignoredShown;
       for (const std::string& ignored : file->ignoredTextures) {

@@ -417,41 +417,68 @@ class SimpleObjImporter : public Assimp::BaseImporter {
   const SimpleObj& obj_;  // outlives the importer (importScene's caller holds it)
 };
 
-// Faces assimp's glTF readers drop for a vertex index out of range: they say so only in a warning
-// of their logger, without a count. While a file is read this stream watches the warnings for
-// that sentence (assimp 5.2's wording), so that the drop is not silent.
-class DroppedFacesWatch : public Assimp::LogStream {
+// What assimp's importers say only in their log, in assimp 5.2's wording, watched while a file is
+// read so that it is not silent: faces its glTF readers drop for a vertex index out of range
+// (without a count), and an OBJ's material library that is not there (its OBJ reader then tries
+// the OBJ's own name with .mtl, the fallback).
+class ImporterLogWatch : public Assimp::LogStream {
  public:
   void write(const char* message) override {
-    if (std::string_view(message).find("faces had out-of-range indices") != std::string_view::npos)
-      seen = true;
+    const std::string_view text(message);
+    if (text.find("faces had out-of-range indices") != std::string_view::npos) droppedFaces = true;
+    if (const std::optional<std::string> name = after(text, "OBJ: Unable to locate material file ");
+        name && missingMaterialLibraries.size() < kMaxIgnoredTextures) {
+      missingMaterialLibraries.push_back(*name);
+    }
+    // Opening is said before the try; a failed one is said after it.
+    if (const std::optional<std::string> name =
+            after(text, "OBJ: Opening fallback material file ")) {
+      fallbackMaterialLibrary = std::filesystem::path(*name).filename().string();  // beside the OBJ
+    }
+    if (text.find("OBJ: Unable to locate fallback material file ") != std::string_view::npos) {
+      fallbackMaterialLibrary.clear();
+    }
   }
-  bool seen = false;
+  bool droppedFaces = false;
+  std::vector<std::string> missingMaterialLibraries;
+  std::string fallbackMaterialLibrary;
+
+ private:
+  // The rest of the message after `lead`, its line break trimmed; nothing without `lead`.
+  static std::optional<std::string> after(std::string_view text, std::string_view lead) {
+    const std::size_t at = text.find(lead);
+    if (at == std::string_view::npos) return std::nullopt;
+    std::string_view rest = text.substr(at + lead.size());
+    while (!rest.empty() && (rest.back() == '\n' || rest.back() == '\r')) rest.remove_suffix(1);
+    return std::string(rest);
+  }
 };
 
-// Attaches a DroppedFacesWatch to assimp's logger, a process-wide singleton, for one ReadFile:
+// Attaches an ImporterLogWatch to assimp's logger, a process-wide singleton, for one ReadFile:
 // one read at a time in a process (the reader program reads one file; tests read in turn).
 class WatchedRead {
  public:
   WatchedRead() : lock_(mutex()) {
     Assimp::DefaultLogger::create(nullptr, Assimp::Logger::NORMAL, 0);
-    Assimp::DefaultLogger::get()->attachStream(&watch_, Assimp::Logger::Warn);
+    Assimp::DefaultLogger::get()->attachStream(&watch_, kSeverities);
   }
   ~WatchedRead() {
-    Assimp::DefaultLogger::get()->detachStream(&watch_, Assimp::Logger::Warn);
+    Assimp::DefaultLogger::get()->detachStream(&watch_, kSeverities);
     Assimp::DefaultLogger::kill();
   }
   WatchedRead(const WatchedRead&) = delete;
   WatchedRead& operator=(const WatchedRead&) = delete;
-  bool droppedFaces() const { return watch_.seen; }
+  const ImporterLogWatch& seen() const { return watch_; }
 
  private:
   static std::mutex& mutex() {
     static std::mutex m;
     return m;
   }
+  static constexpr unsigned kSeverities =
+      Assimp::Logger::Info | Assimp::Logger::Warn | Assimp::Logger::Err;
   std::lock_guard<std::mutex> lock_;
-  DroppedFacesWatch watch_;
+  ImporterLogWatch watch_;
 };
 
 // importMesh with assimp's importer for `extension`, or with SimpleObjImporter alone for
@@ -489,7 +516,11 @@ MeshFile importScene(const std::filesystem::path& path, const std::string& exten
     {
       const WatchedRead watched;
       scene = importer.ReadFile(path.string(), 0);
-      result.importerDroppedFaces = watched.droppedFaces();
+      result.importerDroppedFaces = watched.seen().droppedFaces;
+      result.missingMaterialLibraries = watched.seen().missingMaterialLibraries;
+      if (!result.missingMaterialLibraries.empty()) {
+        result.fallbackMaterialLibrary = watched.seen().fallbackMaterialLibrary;
+      }
     }
     if (!files->refusal().empty()) throw MeshLoadError(files->refusal());
     if (scene == nullptr) throw MeshLoadError(assimpReason(importer.GetErrorString()));

@@ -435,5 +435,27 @@ TEST(MeshImport, GltfFacesTheImporterDropsAreNoted) {
   }
 }
 
+// An OBJ's `mtllib` that is not there is noted (assimp says so only in its log), with the library
+// assimp's OBJ reader falls back to: the OBJ's own name with .mtl, when that is there.
+TEST(MeshImport, AMissingMaterialLibraryIsNoted) {
+  const TempDir dir;
+  const std::string obj = "mtllib nothere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n";
+  const MeshFile alone = readMeshFile(dir.write("alone.obj", obj));
+  EXPECT_EQ(alone.missingMaterialLibraries, std::vector<std::string>{"nothere.mtl"});
+  EXPECT_EQ(alone.fallbackMaterialLibrary, "");
+  dir.write("fallback.mtl", "newmtl red\nKd 1 0 0\n");
+  const MeshFile fallback = readMeshFile(dir.write("fallback.obj", obj));
+  EXPECT_EQ(fallback.missingMaterialLibraries, std::vector<std::string>{"nothere.mtl"});
+  EXPECT_EQ(fallback.fallbackMaterialLibrary, "fallback.mtl");
+  ASSERT_EQ(fallback.materials.size(), 1u);
+  EXPECT_EQ(fallback.materials[0].name, "red");
+  // A library that is there is no note.
+  dir.write("here.mtl", "newmtl red\nKd 1 0 0\n");
+  const MeshFile here = readMeshFile(
+      dir.write("here.obj", "mtllib here.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"));
+  EXPECT_TRUE(here.missingMaterialLibraries.empty());
+  EXPECT_EQ(here.fallbackMaterialLibrary, "");
+}
+
 }  // namespace
 }  // namespace glint::mesh_test

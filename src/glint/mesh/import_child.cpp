@@ -166,6 +166,17 @@ MeshFile receiveMeshFile(Reader& in) {
     }
     ignored = in.text();
   }
+  file.missingMaterialLibraries.resize(static_cast<std::size_t>(in.count(kMaxIgnoredTextures)));
+  for (std::string& library : file.missingMaterialLibraries) {
+    if (in.value<char>() != 'L') {
+      throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+    }
+    library = in.text();
+  }
+  if (in.value<char>() != 'F') {
+    throw MeshLoadError("invalid file: the mesh reader's answer is inconsistent");
+  }
+  file.fallbackMaterialLibrary = in.text();
   file.materials.resize(static_cast<std::size_t>(in.count(1 << 20)));
   for (MeshMaterial& m : file.materials) {
     if (in.value<char>() != 'N') {

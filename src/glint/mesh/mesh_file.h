@@ -140,6 +140,11 @@ struct MeshFile {
   // Textures the materials name that glint does not use, as "map_Ka 'wood.png'" (an OBJ's
   // ambient, opacity, shininess, reflection and displacement maps): reported in a warning.
   std::vector<std::string> ignoredTextures;  // at most kMaxIgnoredTextures
+  // An OBJ's `mtllib` files that are not there, as the file names them (at most
+  // kMaxIgnoredTextures), and the library read instead: the OBJ's own name with .mtl, when that
+  // is there ("" otherwise). Reported in a warning.
+  std::vector<std::string> missingMaterialLibraries;
+  std::string fallbackMaterialLibrary;
   // Of the parts whose normals glint generated (generateSmoothNormals, mesh_repair.h): those whose
   // vertices are smoothed with the vertices at exactly their position only (their smoothing radius
   // reached too many: a far outlier), and the positions whose corners kept their own faces'

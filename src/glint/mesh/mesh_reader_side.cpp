@@ -36,6 +36,11 @@ bool writeMeshFile(int fd, const MeshFile& file) {
   for (const std::string& ignored : file.ignoredTextures) {
     ok = ok && writeMessage(fd, 'I', ignored);
   }
+  ok = ok && writeValue(fd, std::uint64_t{file.missingMaterialLibraries.size()});
+  for (const std::string& library : file.missingMaterialLibraries) {
+    ok = ok && writeMessage(fd, 'L', library);
+  }
+  ok = ok && writeMessage(fd, 'F', file.fallbackMaterialLibrary);
   ok = ok && writeValue(fd, std::uint64_t{file.materials.size()});
   for (const MeshMaterial& m : file.materials) {
     ok = ok && writeMessage(fd, 'N', m.name) && writeValue(fd, m.material) &&

@@ -50,8 +50,9 @@ inline bool writeMessage(int fd, char tag, const std::string& text) {
 
 // The whole answer: 'M', the dropped triangles, whether the importer dropped faces itself (0 or
 // 1), the generated normals' two counts (exactPositionNormalParts, crowdedNormalPositions), the
-// textures the materials name that glint
-// does not use, then the file's materials, embedded images and parts.
+// textures the materials name that glint does not use, the missing material libraries and the one
+// read instead (missingMaterialLibraries, fallbackMaterialLibrary), then the file's materials,
+// embedded images and parts.
 bool writeMeshFile(int fd, const MeshFile& file);
 
 }  // namespace glint::wire
