@@ -120,11 +120,14 @@ ParseResult describeQuickLook(const std::filesystem::path& file, const LoadOptio
   out.close();
   out.addEntity(EntityKind::ObjectEntity, map, type);
 
-  // A ground plane under the lowest point, light grey and dull.
+  // A ground plane under the lowest point, light grey and dull: 1/1000 of the model's size below
+  // it, so that a flat model lying in its lowest plane (a floor plan, a decal) is not in the
+  // ground's plane (the two would speckle through each other); a gap no one sees under a model
+  // standing on its lowest point.
   map = out.nextId();
   out.openMap({});
   type = out.entry("type", "plane", {});
-  vector(out, "point", Vec3{center.x, bounds.lo.y, center.z});
+  vector(out, "point", Vec3{center.x, bounds.lo.y - 1e-3 * radius, center.z});
   vector(out, "normal", Vec3{0, 1, 0});
   out.key("material", {});
   out.openMap({});
