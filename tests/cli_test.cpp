@@ -906,8 +906,9 @@ TEST_F(Cli, MaxMemoryWithABadSizeIsAnArgumentError) {
   // A fraction of a byte is a unit left out, not 2 bytes.
   const RunResult fraction = run({"render", small(), "-o", "out.png", "--max-memory", "2.5"});
   EXPECT_EQ(fraction.status, 2);
-  EXPECT_TRUE(contains(fraction.err, "--max-memory 2.5: a number of bytes must be whole (a size "
-                                     "with a unit may have a fraction: 2.5G, 2.5M)"))
+  EXPECT_TRUE(contains(fraction.err,
+                       "--max-memory 2.5: a number of bytes must be whole (a size "
+                       "with a unit may have a fraction: 2.5G, 2.5M)"))
       << fraction.err;
   EXPECT_TRUE(filesIn(work_).empty());
 }
@@ -1049,11 +1050,22 @@ TEST_F(CliCheckpoint, AFailedImageWriteKeepsTheFinishedRenderInTheCheckpoint) {
 }
 
 TEST_F(CliCheckpoint, ExistingCheckpointIsNotOverwrittenWithoutResume) {
-  writeFile(work_ / "run.ckpt", "precious work");
+  writeFile(work_ / "run.ckpt", "GLINTCKP precious work");
   const RunResult r = run(renderArgs({"-o", "out.ppm", "--checkpoint", "run.ckpt"}));
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "already exists; continue it with --resume run.ckpt")) << r.err;
-  EXPECT_EQ(readFile(work_ / "run.ckpt"), "precious work");
+  EXPECT_EQ(readFile(work_ / "run.ckpt"), "GLINTCKP precious work");
+  EXPECT_FALSE(fs::exists(work_ / "out.ppm"));
+  // Another file in the way (notes, a scene, an image) is not offered for --resume.
+  writeFile(work_ / "notes.txt", "precious work");
+  const RunResult other = run(renderArgs({"-o", "out.ppm", "--checkpoint", "notes.txt"}));
+  EXPECT_EQ(other.status, 2);
+  EXPECT_TRUE(contains(other.err,
+                       "cannot write checkpoint 'notes.txt': the file exists and is not "
+                       "a glint checkpoint; choose another --checkpoint path"))
+      << other.err;
+  EXPECT_FALSE(contains(other.err, "--resume")) << other.err;
+  EXPECT_EQ(readFile(work_ / "notes.txt"), "precious work");
   EXPECT_FALSE(fs::exists(work_ / "out.ppm"));
   // Nor can the checkpoint be the output image.
   const RunResult same = run(renderArgs({"-o", "out.ppm", "--checkpoint", "out.ppm"}));

@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <fstream>
 #include <string>
+#include <string_view>
 #include <system_error>
 
 #include "glint/image/image_writer.h"
@@ -97,6 +99,22 @@ void checkOutputIsNotRead(const fs::path& output, const std::vector<fs::path>& f
   }
 }
 
+namespace {
+
+// Whether `path` is a regular file that begins with the checkpoint's magic bytes (never opened
+// when it is a FIFO or a device).
+bool startsAsCheckpoint(const fs::path& path) {
+  std::error_code error;
+  if (!fs::is_regular_file(path, error)) return false;
+  std::ifstream in(path, std::ios::binary);
+  char magic[kCheckpointMagic.size()] = {};
+  in.read(magic, static_cast<std::streamsize>(sizeof magic));
+  return in.gcount() == static_cast<std::streamsize>(sizeof magic) &&
+         std::string_view(magic, sizeof magic) == kCheckpointMagic;
+}
+
+}  // namespace
+
 std::optional<fs::path> resolveCheckpointPath(const std::optional<fs::path>& checkpoint,
                                               const std::optional<fs::path>& resume,
                                               const fs::path& out) {
@@ -131,11 +149,18 @@ std::optional<fs::path> resolveCheckpointPath(const std::optional<fs::path>& che
   }
   // Starting afresh over an existing checkpoint would throw away the work saved in it.
   const bool continuesIt = resume && sameFile(path, *resume);
-  if (!continuesIt && fs::exists(path, error))
+  if (!continuesIt && fs::exists(path, error)) {
+    // Only a checkpoint is worth continuing; another file (a scene, an image) is simply in the way.
+    if (!startsAsCheckpoint(path))
+      throw JobError(JobFailure::BadInput,
+                     fmt::format("cannot write checkpoint '{}': the file exists and is not a glint "
+                                 "checkpoint; choose another --checkpoint path",
+                                 path.string()));
     throw JobError(JobFailure::BadInput,
                    fmt::format("the checkpoint '{}' already exists; continue it with --resume {}, "
                                "or delete it to start over",
                                path.string(), path.string()));
+  }
   return path;
 }
 
