@@ -100,6 +100,16 @@ TEST_F(Cli, ArgumentParserErrorsExitTwo) {
   r = run({"render", "--", small(), "--width", "16", "-o", "out.png"});
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(contains(r.err, "not expected: --width 16 -o out.png\n")) << r.err;
+  // A misspelt option is named, with the option meant, and the help of its command.
+  r = run({"render", small(), "--widht", "16"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "unknown option '--widht' (did you mean '--width'?)\n")) << r.err;
+  EXPECT_TRUE(contains(r.err, "Run 'glint render --help' for usage.")) << r.err;
+  r = run({"check", small(), "--max-memroy", "1G"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "unknown option '--max-memroy' (did you mean '--max-memory'?)"))
+      << r.err;
+  EXPECT_TRUE(contains(r.err, "Run 'glint check --help' for usage.")) << r.err;
   // A scene name with a leading '-' is read as an option: say so, and how to name the file.
   r = run({"render", "-scene.yaml"});
   EXPECT_EQ(r.status, 2);

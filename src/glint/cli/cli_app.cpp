@@ -38,6 +38,7 @@
 #include "glint/preview/preview_server.h"
 #include "glint/preview/preview_state.h"
 #include "glint/readers/diagnostics.h"
+#include "glint/readers/spelling.h"
 #include "glint/render/film.h"
 #include "glint/render/renderer.h"
 #include "glint/scene/scene.h"
@@ -561,14 +562,34 @@ std::vector<std::string> unplacedArguments(const CLI::App& app) {
   return words;
 }
 
+// The long options of `command` ("--width", ...), for did-you-mean hints.
+std::vector<std::string> longOptions(const CLI::App& command) {
+  std::vector<std::string> names;
+  for (const CLI::Option* option : command.get_options()) {
+    for (const std::string& name : option->get_lnames()) names.push_back("--" + name);
+  }
+  return names;
+}
+
 // Argument-parser errors: CLI11's own message, minus its jargon, plus where to find help.
 int parseFailure(const CLI::ParseError& error, const CLI::App& app, int argc, char** argv) {
   const std::string_view message = error.what();
   const std::size_t colon = message.find(": ");
   const std::vector<std::string> unplaced = unplacedArguments(app);
-  const auto firstOption = std::find_if(unplaced.begin(), unplaced.end(), [](const auto& word) {
-    return word.size() > 1 && word[0] == '-';
-  });
+  // After "--" every word is an argument, not an option.
+  const bool separated = std::any_of(
+      argv, argv + argc, [](const char* word) { return std::string_view(word) == "--"; });
+  const auto firstOption =
+      separated ? unplaced.end()
+                : std::find_if(unplaced.begin(), unplaced.end(),
+                               [](const auto& word) { return word.size() > 1 && word[0] == '-'; });
+  // The command being parsed (render, check, convert), when one was named.
+  const std::vector<CLI::App*> commands = app.get_subcommands();
+  const CLI::App* command = commands.empty() ? nullptr : commands.front();
+  const std::string optionHint =
+      command != nullptr && firstOption != unplaced.end()
+          ? didYouMean(std::string_view(*firstOption), longOptions(*command))
+          : std::string();
   if (message == "A subcommand is required") {
     if (argc >= 2 && argv[1][0] == '-') {
       printError(
@@ -582,13 +603,14 @@ int parseFailure(const CLI::ParseError& error, const CLI::App& app, int argc, ch
     }
   } else if (dynamic_cast<const CLI::RequiredError*>(&error) && firstOption != unplaced.end()) {
     // "glint render -scene.yaml": the name was taken for an option, so SCENE is "missing".
-    printError(
-        fmt::format("unknown option '{}' (a file whose name starts with '-' is written "
-                    "./{})",
-                    *firstOption, *firstOption));
-  } else if (dynamic_cast<const CLI::ExtrasError*>(&error) && unplaced.size() == 1 &&
-             firstOption != unplaced.end()) {
-    printError(fmt::format("unknown option '{}'", unplaced.front()));
+    printError(optionHint.empty()
+                   ? fmt::format("unknown option '{}' (a file whose name starts with '-' is "
+                                 "written ./{})",
+                                 *firstOption, *firstOption)
+                   : fmt::format("unknown option '{}'{}", *firstOption, optionHint));
+  } else if (dynamic_cast<const CLI::ExtrasError*>(&error) && firstOption != unplaced.end()) {
+    // "--widht 100": the value is not expected because its option is unknown.
+    printError(fmt::format("unknown option '{}'{}", *firstOption, optionHint));
   } else if (dynamic_cast<const CLI::ExtrasError*>(&error) && !unplaced.empty()) {
     // CLI11 lists them in reverse order.
     printError(fmt::format("not expected: {}", fmt::join(unplaced, " ")));
@@ -604,7 +626,9 @@ int parseFailure(const CLI::ParseError& error, const CLI::App& app, int argc, ch
   } else {
     printError(message);
   }
-  emit(stderr, "Run 'glint --help' for usage.\n");
+  emit(stderr, command != nullptr
+                   ? fmt::format("Run 'glint {} --help' for usage.\n", command->get_name())
+                   : std::string("Run 'glint --help' for usage.\n"));
   return kExitBadInput;
 }
 
