@@ -512,6 +512,48 @@ TEST(QuickLook, FacesTheMeshLibraryDropsAreAWarning) {
                          "remain"));
 }
 
+// A bare mesh file has no scene folder: what it names outside its own folder (a textures folder
+// beside it) is refused in those words, with the way to use such a layout.
+TEST(QuickLook, FilesOutsideTheModelsFolderAreRefusedWithTheWayOut) {
+  const mesh_test::TempDir dir;
+  fs::create_directories(dir.path() / "models");
+  fs::create_directories(dir.path() / "textures");
+  fs::copy_file(fs::path(GLINT_SOURCE_DIR) / "scenes" / "textures" / "uv_grid.png",
+                dir.path() / "textures" / "uv_grid.png");
+  dir.write("models/m.mtl", "newmtl m\nKd 1 1 1\nmap_Kd ../textures/uv_grid.png\n");
+  const fs::path model = dir.write(
+      "models/m.obj",
+      "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n");
+  const std::string way =
+      "; to use files outside the model's folder (a textures folder beside "
+      "it), render a scene file in a folder that holds both, with a mesh "
+      "object naming the model";
+  try {
+    loadScene(model);
+    ADD_FAILURE() << "loaded";
+  } catch (const SceneError& e) {
+    EXPECT_THAT(e.what(), testing::HasSubstr("(a mesh file may only name files in its own folder "
+                                             "and below)" +
+                                             way));
+  }
+  // A scene file above both reads it.
+  const fs::path scene = dir.write(
+      "scene.yaml",
+      "camera: {position: [0, 0, 3], look_at: [0, 0, 0], fov: 40}\nimage: {width: 8, height: 8}\n"
+      "objects:\n  - {type: mesh, file: models/m.obj}\n");
+  EXPECT_EQ(loadScene(scene).parts.meshes.size(), 1u);
+  // The model's own MTL outside its folder: refused by the reader, with the same way out.
+  dir.write("shared.mtl", "newmtl m\nKd 1 0 0\n");
+  const fs::path outside =
+      dir.write("models/o.obj", "mtllib ../shared.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  try {
+    loadScene(outside);
+    ADD_FAILURE() << "loaded";
+  } catch (const SceneError& e) {
+    EXPECT_THAT(e.what(), testing::HasSubstr("its own folder and below)" + way));
+  }
+}
+
 // An OBJ's material library that is not there is a warning, not a silent grey.
 TEST(QuickLook, AMissingMaterialLibraryIsAWarning) {
   const mesh_test::TempDir dir;

@@ -42,6 +42,14 @@ void light(SceneEmitter& out, const Vec3& towardLight, double intensity) {
 
 }  // namespace
 
+std::string bareMeshFileHint(std::string_view refusal) {
+  if (refusal.find("may only name files in its own folder and below") == std::string_view::npos) {
+    return {};
+  }
+  return "; to use files outside the model's folder (a textures folder beside it), render a scene "
+         "file in a folder that holds both, with a mesh object naming the model";
+}
+
 bool isQuickLookFile(const std::filesystem::path& file) {
   std::string extension = file.extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -55,9 +63,12 @@ ParseResult describeQuickLook(const std::filesystem::path& file, const LoadOptio
   if (base.empty()) base = ".";
   std::shared_ptr<const MeshFile> read;
   try {
+    // No scene folder: the files the model names are judged against its own folder, and the
+    // refusal says so (not "its scene file's folder", which a bare mesh file does not have).
     read = std::make_shared<const MeshFile>(
-        readMeshFile(file, MeshReadOptions{.sceneFolder = base, .cancel = options.cancel}));
+        readMeshFile(file, MeshReadOptions{.sceneFolder = {}, .cancel = options.cancel}));
   } catch (const MeshLoadError& e) {
+    const std::string reason = e.what() + bareMeshFileHint(e.what());
     // At the line and column in the file when the reason names them.
     if (const std::optional<MeshErrorPlace> place = meshErrorPlace(e.what())) {
       throw SceneError({{Diagnostic::Severity::Error,
@@ -66,7 +77,7 @@ ParseResult describeQuickLook(const std::filesystem::path& file, const LoadOptio
     }
     throw SceneError({{Diagnostic::Severity::Error,
                        {name, 0, 0},
-                       fmt::format("cannot load mesh file: {}", e.what())}});
+                       fmt::format("cannot load mesh file: {}", reason)}});
   }
   Bounds3 bounds;
   for (const TriangleMesh& part : read->parts) {
@@ -81,6 +92,7 @@ ParseResult describeQuickLook(const std::filesystem::path& file, const LoadOptio
   result.description = sceneWithFile(name, base);
   SceneDescription& scene = result.description;
   scene.files[0]->bytes = std::filesystem::file_size(file);
+  scene.bareMeshFile = true;
   // The builder's mesh object names the file by its name in `base`: the same file, not read again.
   scene.readMeshFiles.emplace_back(base / file.filename(), read);
   Diagnostics sink;

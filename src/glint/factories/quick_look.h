@@ -7,6 +7,8 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
+#include <string_view>
 
 #include "glint/factories/scene_loader.h"
 #include "glint/readers/yaml_scene_reader.h"
@@ -15,6 +17,10 @@ namespace glint {
 
 // Whether `file`'s extension is a mesh file's (quick look).
 bool isQuickLookFile(const std::filesystem::path& file);
+
+// What to add to a refusal of a file a bare mesh file names outside its own folder: how to use
+// such a layout (a scene file above both); "" for any other reason.
+std::string bareMeshFileHint(std::string_view refusal);
 
 // The quick-look scene of a mesh file, as entities (the mesh is read to find its bounds; a file
 // that cannot be read throws SceneError naming only the file).

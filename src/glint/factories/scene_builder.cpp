@@ -21,6 +21,7 @@
 #include "glint/factories/material_factory.h"
 #include "glint/factories/mesh_textures.h"
 #include "glint/factories/object_factories.h"
+#include "glint/factories/quick_look.h"
 #include "glint/factories/settings_factories.h"
 #include "glint/factories/texture_library.h"
 #include "glint/factories/transform_reader.h"
@@ -657,9 +658,13 @@ class Builder {
     const std::vector<std::uint32_t>* scene = nullptr;
     if (!material.given) {
       try {
-        scene = &fileMaterials(*file, path, baseDirectory(params));
+        // A bare mesh file's quick look has no scene folder: its model's own folder rules.
+        scene = &fileMaterials(*file, path,
+                               d_.bareMeshFile ? std::filesystem::path() : baseDirectory(params));
       } catch (const ImageReadError& e) {
-        params.error(params.place(), fmt::format("mesh file '{}': {}", shown, e.what()));
+        params.error(params.place(),
+                     fmt::format("mesh file '{}': {}{}", shown, e.what(),
+                                 d_.bareMeshFile ? bareMeshFileHint(e.what()) : std::string()));
         return;
       }
     }

@@ -62,6 +62,9 @@ struct SceneDescription {
   std::vector<Entity> entities;                    // in file order
   ValueId name = kNoValue;                         // the top-level `name` (in files[0])
   bool complete = true;                            // false when the reader reported an error
+  // A bare mesh file's quick look (factories/quick_look.h): no scene file, so the files the model
+  // names are judged against the model's own folder.
+  bool bareMeshFile = false;
   // Mesh files the reader has read already (the quick look reads its model to frame it), by the
   // path it read: the builder takes them as read instead of reading them again.
   std::vector<std::pair<std::filesystem::path, std::shared_ptr<const MeshFile>>> readMeshFiles;
