@@ -773,6 +773,57 @@ class Builder {
       sink_.warning(params.location(),
                     fmt::format("{} has zero intensity; it lights nothing", owner));
     }
+    warnIfEnclosed(*light, owner, params.location());
+  }
+
+  // A point or spot light inside a closed opaque solid that does not also hold the camera (a lamp
+  // inside its bulb, forgotten kt) lights only that solid's inside, which the camera cannot see:
+  // almost always a mistake, and the image shows only the other lights.
+  void warnIfEnclosed(const Light& light, const std::string& owner, const SourceLocation& at) {
+    const Point3* position = nullptr;
+    if (const auto* point = std::get_if<PointLight>(&light)) position = &point->position;
+    if (const auto* spot = std::get_if<SpotLight>(&light)) position = &spot->position;
+    if (position == nullptr || enclosedLightWarnings_ >= kMaxDarkObjectWarnings) return;
+    const Point3 eye = parts_.camera.position;
+    for (std::size_t i = 0; i < parts_.primitives.size(); ++i) {
+      const Primitive& p = parts_.primitives[i];
+      if (!isOpaqueClosedSolid(p) || !encloses(p, *position) || encloses(p, eye)) continue;
+      const ObjectPlace& place = objectPlaces_[i];
+      const SourceFile& file = *d_.files[place.file];
+      const SourceLocation where = file.location(place.value);
+      const std::string_view type = file.values.scalar(typeValue(file, place.value));
+      sink_.warning(at, fmt::format("{} is inside the {} at {}:{}:{}, which is opaque and does not "
+                                    "hold the camera: it lights nothing the camera sees (give the "
+                                    "{} a kt, or move the light)",
+                                    owner, type, where.file, where.line, where.column, type));
+      ++enclosedLightWarnings_;
+      return;
+    }
+  }
+
+  // Spheres, boxes, closed cylinders and csg solids (with or without a transform) whose material
+  // passes no light (kt 0; a csg's every operand).
+  bool isOpaqueClosedSolid(const Primitive& p) const {
+    const Shape& shape = p.shape();
+    if (const Csg* csg = p.csg()) {
+      return std::all_of(
+          csg->tree->operands.begin(), csg->tree->operands.end(),
+          [&](const CsgOperand& o) { return isBlack(parts_.materials[o.materialIndex].kt); });
+    }
+    const bool solid = std::holds_alternative<Sphere>(shape) ||
+                       std::holds_alternative<Box>(shape) ||
+                       std::holds_alternative<Cylinder>(shape);
+    return solid && isBlack(parts_.materials[p.materialIndex()].kt);
+  }
+
+  // Whether the closed solid p holds `point`: inside its bounds, and an odd number of surface
+  // crossings along two rays from it (both, so that a ray grazing an edge cannot decide alone).
+  static bool encloses(const Primitive& p, const Point3& point) {
+    if (!p.bounds().contains(point)) return false;
+    for (const Vec3& direction : {Vec3{0.5773, 0.5774, 0.5775}, Vec3{-0.6245, 0.4472, -0.6402}}) {
+      if (p.crossings(Ray{point, direction}, 0, kInfinity) % 2 == 0) return false;
+    }
+    return true;
   }
 
   // --- warnings -------------------------------------------------------------------------------
@@ -950,7 +1001,8 @@ class Builder {
   std::vector<ObjectPlace> objectPlaces_;      // per primitive, where its object was written
   std::vector<std::string_view> objectTypes_;  // in the order messages list them
   std::vector<std::string_view> lightTypes_;
-  TextureLibrary textures_;  // the scene's textures; ctx_.textures points here
+  std::size_t enclosedLightWarnings_ = 0;  // warnIfEnclosed: at most kMaxDarkObjectWarnings
+  TextureLibrary textures_;                // the scene's textures; ctx_.textures points here
 };
 
 }  // namespace

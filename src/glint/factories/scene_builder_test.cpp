@@ -801,6 +801,52 @@ TEST(SceneBuilder, ObjectsThatReflectNoLightUnderLightsAreWarnings) {
             "many.yaml:10:5: warning: 4 more objects reflect no light (this one first)");
 }
 
+// A point or spot light inside a closed opaque solid that does not hold the camera lights nothing
+// the camera sees: a warning at the light. Not for a clear solid, one that holds the camera too
+// (a room), or a light outside.
+TEST(SceneBuilder, ALightInsideAnOpaqueSolidIsAWarning) {
+  const auto warnings = [](const std::string& objects, const std::string& light) {
+    const LoadedScene loaded = loadSceneFromString(
+        std::string(kMinimal) + "materials: {white: {kd: 0.8}, glass: {kd: 0.1, kt: 0.9}}\n" +
+            "objects:\n" + objects + "lights:\n  - " + light + "\n",
+        "lamp.yaml");
+    std::vector<std::string> texts;
+    for (const Diagnostic& d : loaded.warnings) texts.push_back(d.format());
+    return texts;
+  };
+  const std::string bulb = "  - {type: sphere, center: [0, 0, -5], radius: 1, material: white}\n";
+  EXPECT_EQ(warnings(bulb, "{type: point, position: [0, 0.5, -5]}"),
+            std::vector<std::string>{
+                "lamp.yaml:7:5: warning: point light is inside the sphere at lamp.yaml:5:5, which "
+                "is opaque and does not hold the camera: it lights nothing the camera sees (give "
+                "the sphere a kt, or move the light)"});
+  // Through a transform, and in a csg; a spot light alike.
+  EXPECT_EQ(warnings("  - {type: box, min: [-1, -1, -1], max: [1, 1, 1], material: white,\n"
+                     "     transform: [{scale: [3, 1, 1]}, {translate: [0, 0, -5]}]}\n",
+                     "{type: spot, position: [2.5, 0, -5], direction: [0, -1, 0]}")
+                .size(),
+            1u);
+  EXPECT_EQ(warnings("  - {type: csg, operation: difference, material: white, operands: [\n"
+                     "      {type: sphere, center: [0, 0, -5], radius: 2},\n"
+                     "      {type: sphere, center: [0, 0, -5], radius: 1}]}\n",
+                     "{type: point, position: [0, 1.5, -5]}")
+                .size(),
+            1u);
+  // None: a clear bulb, the light in the csg's hollow, a room holding the camera, a light outside.
+  EXPECT_TRUE(warnings("  - {type: sphere, center: [0, 0, -5], radius: 1, material: glass}\n",
+                       "{type: point, position: [0, 0.5, -5]}")
+                  .empty());
+  EXPECT_TRUE(warnings("  - {type: csg, operation: difference, material: white, operands: [\n"
+                       "      {type: sphere, center: [0, 0, -5], radius: 2},\n"
+                       "      {type: sphere, center: [0, 0, -5], radius: 1}]}\n",
+                       "{type: point, position: [0, 0, -5]}")
+                  .empty());
+  EXPECT_TRUE(warnings("  - {type: box, min: [-9, -9, -9], max: [9, 9, 9], material: white}\n",
+                       "{type: point, position: [0, 5, -5]}")
+                  .empty());
+  EXPECT_TRUE(warnings(bulb, "{type: point, position: [0, 1.5, -5]}").empty());
+}
+
 // ------------------------------------------------------------------------------------ mesh objects
 
 // A folder of its own under the system's temporary folder for mesh files, removed afterwards.
