@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -325,6 +326,7 @@ class Builder {
         throw ShapeError("transform", "the placed group " + beyondReach(reach));
       parts_.instances.push_back(makeInstance(
           worldFromGroup, it->second, material.given ? material.index : kNoMaterialOverride));
+      if (!material.given) bareInstances_.push_back({params.location(), it->second});
       const GroupParts& placed = parts_.groups[it->second];
       if (placed.primitives.empty() && placed.meshes.empty()) {
         sink_.warning(params.location(group->where),
@@ -956,11 +958,45 @@ class Builder {
                                       "0): under the lights it shows only the ambient light",
                                       type));
     }
+    // Instances that give no material, once per group: a group object without one (or with a
+    // dark one) shows only the ambient light there too.
+    std::set<std::uint32_t> groupsSeen;
+    for (const auto& [where, group] : bareInstances_) {
+      if (!groupsSeen.insert(group).second || !groupHasDarkObject(parts_.groups[group])) continue;
+      if (++dark > kMaxDarkObjectWarnings) {
+        if (!firstUnshown) firstUnshown = where;
+        continue;
+      }
+      const auto name = std::find_if(groupIndex_.begin(), groupIndex_.end(),
+                                     [&](const auto& entry) { return entry.second == group; });
+      sink_.warning(where, fmt::format("instance of group '{}': an object of the group reflects "
+                                       "no light (no material, and the instance gives none): "
+                                       "under the lights it shows only the ambient light (give "
+                                       "the instance or the object a material with kd or ks)",
+                                       name == groupIndex_.end() ? std::string()
+                                                                 : nameForMessage(name->first)));
+    }
     if (dark > kMaxDarkObjectWarnings) {
       // At the first object not named, so that the line comes after the five that are.
       sink_.warning(*firstUnshown, fmt::format("{} more objects reflect no light (this one first)",
                                                dark - kMaxDarkObjectWarnings));
     }
+  }
+
+  // Whether a group holds an object that reflects no light and does not glow (a csg: every
+  // operand), as placed by an instance without a material.
+  bool groupHasDarkObject(const GroupParts& group) const {
+    for (const Primitive& p : group.primitives) {
+      if (!isDark(p.emission(), p.materialIndex())) continue;
+      const Csg* csg = p.csg();
+      if (csg == nullptr ||
+          std::all_of(csg->tree->operands.begin(), csg->tree->operands.end(),
+                      [&](const CsgOperand& o) { return isDark(o.emission, o.materialIndex); })) {
+        return true;
+      }
+    }
+    return std::any_of(group.meshes.begin(), group.meshes.end(),
+                       [&](const TriangleMesh& m) { return isDark(m.emission, m.materialIndex); });
   }
 
   static ValueId typeValue(const SourceFile& file, ValueId map) {
@@ -1001,8 +1037,11 @@ class Builder {
   std::vector<ObjectPlace> objectPlaces_;      // per primitive, where its object was written
   std::vector<std::string_view> objectTypes_;  // in the order messages list them
   std::vector<std::string_view> lightTypes_;
-  std::size_t enclosedLightWarnings_ = 0;  // warnIfEnclosed: at most kMaxDarkObjectWarnings
-  TextureLibrary textures_;                // the scene's textures; ctx_.textures points here
+  std::size_t enclosedLightWarnings_ = 0;
+  // Instances that give no material: where, and the group placed (warnAboutDarkObjects).
+  std::vector<std::pair<SourceLocation, std::uint32_t>>
+      bareInstances_;        // warnIfEnclosed: at most kMaxDarkObjectWarnings
+  TextureLibrary textures_;  // the scene's textures; ctx_.textures points here
 };
 
 }  // namespace

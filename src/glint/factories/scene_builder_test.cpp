@@ -801,6 +801,36 @@ TEST(SceneBuilder, ObjectsThatReflectNoLightUnderLightsAreWarnings) {
             "many.yaml:10:5: warning: 4 more objects reflect no light (this one first)");
 }
 
+// A group object without a material, placed by an instance that gives none, is as dark as a
+// plain object: one warning at the first such instance of the group.
+TEST(SceneBuilder, AnInstanceOfAnUnlitGroupObjectIsAWarning) {
+  const LoadedScene loaded = loadSceneFromString(
+      std::string(kMinimal) +
+          "groups:\n"
+          "  ball: [{type: sphere, center: [0, 0, -5], radius: 1}]\n"
+          "  lit: [{type: sphere, center: [0, 0, -5], radius: 1, material: {kd: 0.5}}]\n"
+          "objects:\n"
+          "  - {type: instance, group: ball}\n"
+          "  - {type: instance, group: ball, transform: [{translate: [2, 0, 0]}]}\n"
+          "  - {type: instance, group: ball, material: {kd: 0.5}}\n"
+          "  - {type: instance, group: lit}\n"
+          "lights: [{type: point, position: [0, 0, 5]}]\n",
+      "groups.yaml");
+  ASSERT_EQ(loaded.warnings.size(), 1u);
+  EXPECT_EQ(loaded.warnings[0].format(),
+            "groups.yaml:7:5: warning: instance of group 'ball': an object of the group reflects "
+            "no light (no material, and the instance gives none): under the lights it shows only "
+            "the ambient light (give the instance or the object a material with kd or ks)");
+  // Every instance of the group giving a material: none.
+  const LoadedScene given =
+      loadSceneFromString(std::string(kMinimal) +
+                              "groups: {ball: [{type: sphere, center: [0, 0, -5], radius: 1}]}\n"
+                              "objects: [{type: instance, group: ball, material: {kd: 0.5}}]\n"
+                              "lights: [{type: point, position: [0, 0, 5]}]\n",
+                          "given.yaml");
+  EXPECT_TRUE(given.warnings.empty());
+}
+
 // A point or spot light inside a closed opaque solid that does not hold the camera lights nothing
 // the camera sees: a warning at the light. Not for a clear solid, one that holds the camera too
 // (a room), or a light outside.
