@@ -158,10 +158,13 @@ def shapes(out):
             # smooth triangle's normals to the side its winding faces the viewer from).
             for tri in ((p(a0, e0), p(a1, e1), p(a1, e0), n(a0, e0), n(a1, e1), n(a1, e0)),
                         (p(a0, e0), p(a0, e1), p(a1, e1), n(a0, e0), n(a0, e1), n(a1, e1))):
+                written = [f"{v[0]:.4f} {v[1]:.4f} {v[2]:.4f}" for v in tri]
+                # At the pole two corners meet: no triangle (glint would drop it with a warning).
+                if len(set(written[:3])) < 3:
+                    continue
                 out.append("STRI " + " ".join(
-                    f"{k}{j} {v[0]:.4f} {v[1]:.4f} {v[2]:.4f}"
-                    for (k, j), v in zip([("V", 0), ("V", 1), ("V", 2), ("N", 0), ("N", 1),
-                                          ("N", 2)], tri)) + " gold")
+                    f"{k}{j} {v}" for (k, j), v in zip([("V", 0), ("V", 1), ("V", 2), ("N", 0),
+                                                        ("N", 1), ("N", 2)], written)) + " gold")
     for i in range(8):
         a0, a1 = 2 * math.pi * i / 8, 2 * math.pi * (i + 1) / 8
         c0 = (0.5 + 0.5 * math.cos(a0), 0.5 + 0.5 * math.sin(a0), 0.5)
