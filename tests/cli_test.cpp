@@ -163,7 +163,7 @@ TEST_F(Cli, CheckPrintsASummaryAndWritesNothing) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(contains(r.out, "cli small")) << r.out;
   EXPECT_TRUE(contains(r.out, "32x24")) << r.out;
-  EXPECT_TRUE(contains(r.out, "objects:   4 (3 bounded, 1 unbounded)")) << r.out;
+  EXPECT_TRUE(contains(r.out, "shapes:    4 (3 bounded, 1 unbounded)")) << r.out;
   EXPECT_TRUE(contains(r.out, "lights:    2 + ambient")) << r.out;
   EXPECT_TRUE(contains(r.out, "materials:")) << r.out;
   EXPECT_TRUE(contains(r.out, "bounds:")) << r.out;

@@ -355,7 +355,7 @@ int runCheck(const std::string& file, const std::optional<std::string>& maxMemor
   text +=
       fmt::format("image:     {}x{}, {}, {} encoding\n", scene.image.width, scene.image.height,
                   samplesText(scene), scene.image.encoding == Encoding::Srgb ? "srgb" : "linear");
-  text += fmt::format("objects:   {} ({} bounded, {} unbounded)\n", scene.objects,
+  text += fmt::format("shapes:    {} ({} bounded, {} unbounded)\n", scene.objects,
                       scene.objects - scene.unboundedObjects, scene.unboundedObjects);
   text += fmt::format("meshes:    {} ({} triangles)\n", scene.meshes, scene.triangles);
   if (scene.instances > 0) {
