@@ -170,6 +170,33 @@ TEST_F(Cli, CheckPrintsASummaryAndWritesNothing) {
   EXPECT_TRUE(filesIn(work_).empty());
 }
 
+// check takes render's scene options and reports what that render would: their warnings, and
+// the image they ask for refused, naming them.
+TEST_F(Cli, CheckTakesRendersSceneOptions) {
+  writeFile(work_ / "ao.yaml",
+            "camera: {position: [0, 0, 5], look_at: [0, 0, 0], fov: 40}\n"
+            "image: {width: 32, height: 24}\n"
+            "render: {ambient_occlusion: {samples: 4}}\n"
+            "objects: [{type: sphere, center: [0, 0, 0], radius: 1, material: {kd: 0.5}}]\n"
+            "lights: [{type: point, position: [0, 4, 4]}]\n");
+  RunResult r = run({"check", "ao.yaml"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(contains(r.err, "warning")) << r.err;
+  r = run({"check", "ao.yaml", "--integrator", "path", "--samples", "4", "--seed", "3"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(contains(r.err,
+                       "ao.yaml:3:10: warning: render.ambient_occlusion has no effect: it is "
+                       "an option of the whitted integrator, and this render uses path "
+                       "(--integrator)"))
+      << r.err;
+  EXPECT_TRUE(contains(r.out, "32x24, 4 samples per pixel")) << r.out;
+  r = run({"check", "ao.yaml", "--width", "60000", "--height", "60000"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "--width 60000 --height 60000 refused")) << r.err;
+  EXPECT_EQ(run({"check", "ao.yaml", "--integrator", "bidir"}).status, 2);
+  EXPECT_EQ(filesIn(work_), std::set<std::string>{"ao.yaml"});
+}
+
 // scenes/mesh.yaml places scenes/meshes/torus_knot.obj (38,400 triangles, one material) twice.
 TEST_F(Cli, CheckCountsMeshesAndTheirTriangles) {
   const RunResult r =

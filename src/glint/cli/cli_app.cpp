@@ -339,10 +339,17 @@ int reportJobError(const JobError& error, const std::string& sceneFile) {
 
 // --- commands -------------------------------------------------------------------------------
 
-int runCheck(const std::string& file, const std::optional<std::string>& maxMemory) {
+RenderJobSpec parseRequest(const RenderArgs& args);
+
+// `args`: the scene, --max-memory and the scene overrides render takes (the rest empty).
+int runCheck(const RenderArgs& args) {
+  const std::string& file = args.scene;
+  const RenderJobSpec request = parseRequest(args);
   CheckOptions options;
   options.warnings = printWarnings;
-  if (maxMemory) options.memoryBudget = parseMemorySize(*maxMemory);
+  options.memoryBudget = request.memoryBudget;
+  options.overrides = request.overrides;
+  options.requestText = request.requestText;
   SceneFacts scene;
   try {
     scene = checkScene(file, options);
@@ -709,19 +716,31 @@ int runCommandLine(int argc, char** argv) {
   render->add_flag("--stats", args.stats, "More statistics at the end");
   const PreviewOptions previewOptions(*render);
 
-  std::string checkFile, checkMaxMemory;
+  std::string checkFile, checkMaxMemory, checkWidth, checkHeight, checkSamples, checkSeed,
+      checkIntegrator;
   CLI::App* check =
       app.add_subcommand("check", "Parse and build a scene, print a summary; writes nothing");
   check->add_option("SCENE", checkFile, "Scene file (YAML, JSON, .nff, .dat, or a mesh file)")
       ->required()
       ->type_name("FILE");
-  // The memory estimate's refusals are among the errors check reports as render does.
+  // The memory estimate's refusals and the warnings render's options bring (a path integrator,
+  // more samples) are among what check reports as render does.
   CLI::Option* checkMaxMemoryOption =
       check
           ->add_option("--max-memory", checkMaxMemory,
                        "Memory the scene may need, as for render (default: half the physical "
                        "memory)")
           ->type_name("SIZE");
+  CLI::Option* checkWidthOption =
+      check->add_option("--width", checkWidth, "As for render")->type_name("W");
+  CLI::Option* checkHeightOption =
+      check->add_option("--height", checkHeight, "As for render")->type_name("H");
+  CLI::Option* checkSamplesOption =
+      check->add_option("--samples", checkSamples, "As for render")->type_name("N");
+  CLI::Option* checkSeedOption =
+      check->add_option("--seed", checkSeed, "As for render")->type_name("S");
+  CLI::Option* checkIntegratorOption =
+      check->add_option("--integrator", checkIntegrator, "As for render")->type_name("NAME");
 
   std::string convertFile, convertOutput;
   CLI::App* convert = app.add_subcommand(
@@ -793,7 +812,17 @@ int runCommandLine(int argc, char** argv) {
     throw CliError(kExitBadInput, error.what());
   }
 
-  if (check->parsed()) return runCheck(checkFile, given(checkMaxMemoryOption, checkMaxMemory));
+  if (check->parsed()) {
+    RenderArgs checkArgs;
+    checkArgs.scene = checkFile;
+    checkArgs.maxMemory = given(checkMaxMemoryOption, checkMaxMemory);
+    checkArgs.width = given(checkWidthOption, checkWidth);
+    checkArgs.height = given(checkHeightOption, checkHeight);
+    checkArgs.samples = given(checkSamplesOption, checkSamples);
+    checkArgs.seed = given(checkSeedOption, checkSeed);
+    checkArgs.integrator = given(checkIntegratorOption, checkIntegrator);
+    return runCheck(checkArgs);
+  }
   SignalGuard signals;
   if (convert->parsed()) return runConvert(convertFile, convertOutput, signals);
   return runRender(args, signals);

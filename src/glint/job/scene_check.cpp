@@ -173,12 +173,13 @@ std::optional<Diagnostic> pixelWorkWarning(const std::string& file, const SceneP
 SceneFacts checkScene(const std::filesystem::path& file, const CheckOptions& options) {
   LoadOptions load;
   load.memoryBudget = options.memoryBudget;
+  load.overrides = options.overrides;
   load.cancel = options.cancel;
   LoadedScene loaded = loadSceneFile(file, load);
   if (std::optional<Diagnostic> warning = pixelWorkWarning(file.string(), loaded.parts))
     loaded.warnings.push_back(std::move(*warning));
   if (options.warnings && !loaded.warnings.empty()) options.warnings(loaded.warnings);
-  enforceImageLimits(loaded.parts.image, "", options.memoryBudget);
+  enforceImageLimits(loaded.parts.image, options.requestText, options.memoryBudget);
   return sceneFacts(freezeScene(std::move(loaded.parts), file.string()));
 }
 

@@ -17,6 +17,7 @@
 #include "glint/render/renderer.h"
 #include "glint/scene/scene.h"
 #include "glint/scene/scene_limits.h"
+#include "glint/scene/scene_overrides.h"
 
 namespace glint {
 
@@ -54,6 +55,11 @@ std::optional<Diagnostic> pixelWorkWarning(const std::string& file, const SceneP
 
 struct CheckOptions {
   std::uint64_t memoryBudget = defaultImageMemoryBudget();  // as LoadOptions::memoryBudget
+  // The render command's --width/--height/--samples/--seed/--integrator, applied as a render
+  // applies them, so that check reports what that render would; requestText names them in a
+  // refusal of the image (as RenderJobSpec::requestText).
+  SceneOverrides overrides{};
+  std::string requestText;
   // Polled while loading (factories/scene_loader.h); when set the check throws Cancelled.
   const std::atomic<bool>* cancel = nullptr;
   // Hears the scene's warnings (the loader's, then pixelWorkWarning's) as soon as it is loaded,
