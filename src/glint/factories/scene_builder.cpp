@@ -961,7 +961,10 @@ class Builder {
     // Instances that give no material, once per group: a group object without one (or with a
     // dark one) shows only the ambient light there too.
     std::set<std::uint32_t> groupsSeen;
-    for (const auto& [where, group] : bareInstances_) {
+    // (Not a structured binding: the fuzzers' clang cannot capture one in a lambda.)
+    for (const std::pair<SourceLocation, std::uint32_t>& instance : bareInstances_) {
+      const SourceLocation& where = instance.first;
+      const std::uint32_t group = instance.second;
       if (!groupsSeen.insert(group).second || !groupHasDarkObject(parts_.groups[group])) continue;
       if (++dark > kMaxDarkObjectWarnings) {
         if (!firstUnshown) firstUnshown = where;
