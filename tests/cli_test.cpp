@@ -110,6 +110,12 @@ TEST_F(Cli, ArgumentParserErrorsExitTwo) {
   EXPECT_TRUE(contains(r.err, "unknown option '--max-memroy' (did you mean '--max-memory'?)"))
       << r.err;
   EXPECT_TRUE(contains(r.err, "Run 'glint check --help' for usage.")) << r.err;
+  r = run({"render", small(), "--widht=16"});
+  EXPECT_TRUE(contains(r.err, "unknown option '--widht=16' (did you mean '--width'?)")) << r.err;
+  // A negative number is no option: the leftover words are named as they are.
+  r = run({"render", small(), "3", "-1"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "not expected: 3 -1\n")) << r.err;
   // A scene name with a leading '-' is read as an option: say so, and how to name the file.
   r = run({"render", "-scene.yaml"});
   EXPECT_EQ(r.status, 2);

@@ -525,9 +525,10 @@ TEST(QuickLook, FilesOutsideTheModelsFolderAreRefusedWithTheWayOut) {
       "models/m.obj",
       "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n");
   const std::string way =
-      "; to use files outside the model's folder (a textures folder beside "
-      "it), render a scene file in a folder that holds both, with a mesh "
-      "object naming the model";
+      "; to use files outside the model's folder (a textures folder beside it), render a scene "
+      "file written in a folder that holds both, with a mesh object naming the model (`objects: "
+      "[{type: mesh, file: models/m.obj}]`, and a camera: glint convert cannot write it, as it "
+      "reads the model the same way)";
   try {
     loadScene(model);
     ADD_FAILURE() << "loaded";
@@ -562,8 +563,16 @@ TEST(QuickLook, AMissingMaterialLibraryIsAWarning) {
   ASSERT_EQ(loaded.warnings.size(), 1u);
   EXPECT_THAT(loaded.warnings[0].format(),
               testing::HasSubstr("warning: mesh file 'knot.obj': its material library "
-                                 "'knot-copper.mtl' is not there: the faces of its materials get "
-                                 "the default material"));
+                                 "'knot-copper.mtl' is not there (the mesh library takes a whole "
+                                 "mtllib line as one file name); a material no library defines "
+                                 "is mid-grey"));
+  // An object material replaces the file's: nothing to say.
+  const fs::path scene = dir.write(
+      "scene.yaml",
+      "camera: {position: [0, 0, 3], look_at: [0, 0, 0], fov: 40}\nimage: {width: 8, height: 8}\n"
+      "objects:\n  - {type: mesh, file: knot.obj, material: {kd: 0.5}}\n"
+      "lights: [{type: point, position: [0, 0, 3]}]\n");
+  EXPECT_TRUE(loadScene(scene).warnings.empty());
 }
 
 // The quick look reads its model once: to frame it, and the scene's mesh object takes that read

@@ -135,7 +135,8 @@ PixelRegion parseCrop(const std::string& text) {
 }
 
 // "512M", "4G", "1.5GiB", "100000": bytes, with an optional binary unit K, M, G or T (powers of
-// 1024; "KB", "KiB" and "k" mean the same), fractions allowed; at least 1 byte.
+// 1024; "KB", "KiB" and "k" mean the same), fractions allowed with a unit (a fraction of a byte is
+// a unit left out: an error); at least 1 byte.
 std::uint64_t parseMemorySize(const std::string& text) {
   const auto bad = [&text]() {
     return CliError(kExitBadInput,
@@ -583,19 +584,25 @@ int parseFailure(const CLI::ParseError& error, const CLI::App& app, int argc, ch
   const std::string_view message = error.what();
   const std::size_t colon = message.find(": ");
   const std::vector<std::string> unplaced = unplacedArguments(app);
-  // After "--" every word is an argument, not an option.
-  const bool separated = std::any_of(
+  // An option is a word of '-' or '--' and a letter given before any "--" (after it every word
+  // is an argument); "-1" is a number.
+  char** const separator = std::find_if(
       argv, argv + argc, [](const char* word) { return std::string_view(word) == "--"; });
-  const auto firstOption =
-      separated ? unplaced.end()
-                : std::find_if(unplaced.begin(), unplaced.end(),
-                               [](const auto& word) { return word.size() > 1 && word[0] == '-'; });
+  const auto isOption = [&](const std::string& word) {
+    const std::size_t dashes = word.starts_with("--") ? 2 : word.starts_with("-") ? 1 : 0;
+    return dashes > 0 && word.size() > dashes &&
+           std::isalpha(static_cast<unsigned char>(word[dashes])) != 0 &&
+           std::any_of(argv, separator, [&](const char* given) { return word == given; });
+  };
+  const auto firstOption = std::find_if(unplaced.begin(), unplaced.end(), isOption);
   // The command being parsed (render, check, convert), when one was named.
   const std::vector<CLI::App*> commands = app.get_subcommands();
   const CLI::App* command = commands.empty() ? nullptr : commands.front();
+  // "--widht=100" is matched as "--widht".
   const std::string optionHint =
       command != nullptr && firstOption != unplaced.end()
-          ? didYouMean(std::string_view(*firstOption), longOptions(*command))
+          ? didYouMean(std::string_view(*firstOption).substr(0, firstOption->find('=')),
+                       longOptions(*command))
           : std::string();
   if (message == "A subcommand is required") {
     if (argc >= 2 && argv[1][0] == '-') {

@@ -47,7 +47,9 @@ std::string bareMeshFileHint(std::string_view refusal) {
     return {};
   }
   return "; to use files outside the model's folder (a textures folder beside it), render a scene "
-         "file in a folder that holds both, with a mesh object naming the model";
+         "file written in a folder that holds both, with a mesh object naming the model "
+         "(`objects: [{type: mesh, file: models/m.obj}]`, and a camera: glint convert cannot "
+         "write it, as it reads the model the same way)";
 }
 
 bool isQuickLookFile(const std::filesystem::path& file) {

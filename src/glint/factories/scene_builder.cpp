@@ -117,6 +117,7 @@ class Builder {
     for (const Entity& e : d_.entities) {
       if (e.kind == EntityKind::LightEntity) buildLight(e);
     }
+    countEnclosedLights();
     warnIfUnlit();
     warnAboutDarkObjects();
     result_.diagnostics = sink_.take();
@@ -326,7 +327,9 @@ class Builder {
         throw ShapeError("transform", "the placed group " + beyondReach(reach));
       parts_.instances.push_back(makeInstance(
           worldFromGroup, it->second, material.given ? material.index : kNoMaterialOverride));
-      if (!material.given) bareInstances_.push_back({params.location(), it->second});
+      if (!material.given) {
+        bareInstances_.push_back({params.location(), it->second, parts_.primitives.size()});
+      }
       const GroupParts& placed = parts_.groups[it->second];
       if (placed.primitives.empty() && placed.meshes.empty()) {
         sink_.warning(params.location(group->where),
@@ -617,19 +620,6 @@ class Builder {
                                 named, file->crowdedNormalPositions,
                                 file->crowdedNormalPositions == 1 ? "" : "s", kMaxSmoothedCorners));
     }
-    for (const std::string& library : file->missingMaterialLibraries) {
-      // The reader's text: not trusted.
-      sink_.warning(
-          params.location(),
-          file->fallbackMaterialLibrary.empty()
-              ? fmt::format("{}: its material library '{}' is not there: the faces of its "
-                            "materials get the default material",
-                            named, shortenForMessage(library))
-              : fmt::format("{}: its material library '{}' is not there; the materials come from "
-                            "'{}' beside it (the OBJ's own name), as the mesh library reads it",
-                            named, shortenForMessage(library),
-                            shortenForMessage(file->fallbackMaterialLibrary)));
-    }
     if (!file->ignoredTextures.empty()) {
       std::vector<std::string> ignoredShown;
       for (const std::string& ignored : file->ignoredTextures) {
@@ -653,6 +643,22 @@ class Builder {
                  const std::optional<TextureId>& emissionTexture) {
     const std::shared_ptr<const MeshFile> file = loadMesh(params, request);
     if (file == nullptr) return;
+    // Only where the file's own materials are used: an object `material` replaces them all.
+    if (!material.given) {
+      for (const std::string& library : file->missingMaterialLibraries) {
+        // The reader's text: not trusted.
+        sink_.warning(params.location(),
+                      file->fallbackMaterialLibrary.empty()
+                          ? fmt::format("mesh file '{}': its material library '{}' is not there "
+                                        "(the mesh library takes a whole mtllib line as one file "
+                                        "name); a material no library defines is mid-grey",
+                                        escapeForMessage(request.file), shortenForMessage(library))
+                          : fmt::format("mesh file '{}': its material library '{}' is not there; "
+                                        "the mesh library read '{}' (the OBJ's own name) instead",
+                                        escapeForMessage(request.file), shortenForMessage(library),
+                                        shortenForMessage(file->fallbackMaterialLibrary)));
+      }
+    }
     const std::filesystem::path written(request.file);
     const std::filesystem::path path =
         written.is_relative() ? baseDirectory(params) / written : written;
@@ -785,11 +791,20 @@ class Builder {
     const Point3* position = nullptr;
     if (const auto* point = std::get_if<PointLight>(&light)) position = &point->position;
     if (const auto* spot = std::get_if<SpotLight>(&light)) position = &spot->position;
-    if (position == nullptr || enclosedLightWarnings_ >= kMaxDarkObjectWarnings) return;
+    if (position == nullptr) return;
     const Point3 eye = parts_.camera.position;
     for (std::size_t i = 0; i < parts_.primitives.size(); ++i) {
       const Primitive& p = parts_.primitives[i];
-      if (!isOpaqueClosedSolid(p) || !encloses(p, *position) || encloses(p, eye)) continue;
+      // The light surely inside; the camera not even on the surface (a camera in a room's wall
+      // sees the room).
+      if (!isOpaqueClosedSolid(p) || !encloses(p, *position, Probe::AllOdd) ||
+          encloses(p, eye, Probe::AnyOdd)) {
+        continue;
+      }
+      if (++enclosedLights_ > kMaxDarkObjectWarnings) {
+        if (!firstUnnamedEnclosedLight_) firstUnnamedEnclosedLight_ = at;
+        return;
+      }
       const ObjectPlace& place = objectPlaces_[i];
       const SourceFile& file = *d_.files[place.file];
       const SourceLocation where = file.location(place.value);
@@ -798,9 +813,17 @@ class Builder {
                                     "hold the camera: it lights nothing the camera sees (give the "
                                     "{} a kt, or move the light)",
                                     owner, type, where.file, where.line, where.column, type));
-      ++enclosedLightWarnings_;
       return;
     }
+  }
+
+  // After the lights: how many more lights than were named are inside opaque solids.
+  void countEnclosedLights() {
+    if (!firstUnnamedEnclosedLight_) return;
+    sink_.warning(*firstUnnamedEnclosedLight_,
+                  fmt::format("{} more lights are inside opaque solids that do not hold the camera "
+                              "(this one first)",
+                              enclosedLights_ - kMaxDarkObjectWarnings));
   }
 
   // Spheres, boxes, closed cylinders and csg solids (with or without a transform) whose material
@@ -819,13 +842,16 @@ class Builder {
   }
 
   // Whether the closed solid p holds `point`: inside its bounds, and an odd number of surface
-  // crossings along two rays from it (both, so that a ray grazing an edge cannot decide alone).
-  static bool encloses(const Primitive& p, const Point3& point) {
+  // crossings along two rays from it — both (surely inside: a ray grazing an edge cannot decide
+  // alone), or either (inside or on the surface, where a ray leaving through it crosses nothing).
+  enum class Probe { AllOdd, AnyOdd };
+  static bool encloses(const Primitive& p, const Point3& point, Probe probe) {
     if (!p.bounds().contains(point)) return false;
+    int odd = 0;
     for (const Vec3& direction : {Vec3{0.5773, 0.5774, 0.5775}, Vec3{-0.6245, 0.4472, -0.6402}}) {
-      if (p.crossings(Ray{point, direction}, 0, kInfinity) % 2 == 0) return false;
+      odd += p.crossings(Ray{point, direction}, 0, kInfinity) % 2;
     }
-    return true;
+    return probe == Probe::AllOdd ? odd == 2 : odd > 0;
   }
 
   // --- warnings -------------------------------------------------------------------------------
@@ -928,78 +954,82 @@ class Builder {
   // almost always a forgotten material.
   void warnAboutDarkObjects() {
     if (sink_.hasErrors() || parts_.lights.empty()) return;
-    std::size_t dark = 0;
-    std::optional<SourceLocation> firstUnshown;  // where the count of the rest is said
+    // Every dark object in file order: primitive i at (i, 1); an instance at (the primitives
+    // built before it, 0), so that it sorts before the next primitive.
+    struct DarkObject {
+      std::pair<std::size_t, int> order;
+      SourceLocation where;
+      std::string message;
+    };
+    std::vector<DarkObject> darkObjects;
     for (std::size_t i = 0; i < parts_.primitives.size(); ++i) {
       const Primitive& p = parts_.primitives[i];
-      if (!isDark(p.emission(), p.materialIndex())) continue;
-      if (const Csg* csg = p.csg()) {
-        const auto& operands = csg->tree->operands;
-        if (!std::all_of(operands.begin(), operands.end(), [&](const CsgOperand& o) {
-              return isDark(o.emission, o.materialIndex);
-            })) {
-          continue;
-        }
-      }
+      if (!isDarkPrimitive(p)) continue;
       const ObjectPlace& place = objectPlaces_[i];
       const SourceFile& file = *d_.files[place.file];
-      if (++dark > kMaxDarkObjectWarnings) {
-        if (!firstUnshown) firstUnshown = file.location(place.value);
-        continue;
-      }
       const std::string_view type = file.values.scalar(typeValue(file, place.value));
-      sink_.warning(file.location(place.value),
-                    p.materialIndex() == 0
-                        ? fmt::format("{} has no material, so it reflects no light: under the "
-                                      "lights it shows only the ambient light (give it a material "
-                                      "with kd or ks)",
-                                      type)
-                        : fmt::format("{}'s material reflects no light (kd, ks, kr and kt are all "
-                                      "0): under the lights it shows only the ambient light",
-                                      type));
+      darkObjects.push_back(
+          {{i, 1},
+           file.location(place.value),
+           p.materialIndex() == 0
+               ? fmt::format("{} has no material, so it reflects no light: under the lights it "
+                             "shows only the ambient light (give it a material with kd or ks)",
+                             type)
+               : fmt::format("{}'s material reflects no light (kd, ks, kr and kt are all 0): "
+                             "under the lights it shows only the ambient light",
+                             type)});
     }
-    // Instances that give no material, once per group: a group object without one (or with a
-    // dark one) shows only the ambient light there too.
+    // Instances that give no material, once per group: a group object written without one shows
+    // only the ambient light there too.
     std::set<std::uint32_t> groupsSeen;
-    // (Not a structured binding: the fuzzers' clang cannot capture one in a lambda.)
-    for (const std::pair<SourceLocation, std::uint32_t>& instance : bareInstances_) {
-      const SourceLocation& where = instance.first;
-      const std::uint32_t group = instance.second;
-      if (!groupsSeen.insert(group).second || !groupHasDarkObject(parts_.groups[group])) continue;
-      if (++dark > kMaxDarkObjectWarnings) {
-        if (!firstUnshown) firstUnshown = where;
+    for (const BareInstance& instance : bareInstances_) {
+      if (!groupsSeen.insert(instance.group).second ||
+          !groupHasObjectWithoutMaterial(parts_.groups[instance.group])) {
         continue;
       }
+      const std::uint32_t group = instance.group;
       const auto name = std::find_if(groupIndex_.begin(), groupIndex_.end(),
                                      [&](const auto& entry) { return entry.second == group; });
-      sink_.warning(where, fmt::format("instance of group '{}': an object of the group reflects "
-                                       "no light (no material, and the instance gives none): "
-                                       "under the lights it shows only the ambient light (give "
-                                       "the instance or the object a material with kd or ks)",
-                                       name == groupIndex_.end() ? std::string()
-                                                                 : nameForMessage(name->first)));
+      darkObjects.push_back(
+          {{instance.primitivesBefore, 0},
+           instance.where,
+           fmt::format("instance of group '{}': an object of the group has no material and the "
+                       "instance gives none, so it reflects no light: under the lights it shows "
+                       "only the ambient light (give the instance or the object a material with "
+                       "kd or ks)",
+                       name == groupIndex_.end() ? std::string() : nameForMessage(name->first))});
     }
-    if (dark > kMaxDarkObjectWarnings) {
+    std::stable_sort(darkObjects.begin(), darkObjects.end(),
+                     [](const DarkObject& a, const DarkObject& b) { return a.order < b.order; });
+    for (std::size_t k = 0; k < darkObjects.size() && k < kMaxDarkObjectWarnings; ++k) {
+      sink_.warning(darkObjects[k].where, darkObjects[k].message);
+    }
+    if (darkObjects.size() > kMaxDarkObjectWarnings) {
       // At the first object not named, so that the line comes after the five that are.
-      sink_.warning(*firstUnshown, fmt::format("{} more objects reflect no light (this one first)",
-                                               dark - kMaxDarkObjectWarnings));
+      sink_.warning(darkObjects[kMaxDarkObjectWarnings].where,
+                    fmt::format("{} more objects reflect no light (this one first)",
+                                darkObjects.size() - kMaxDarkObjectWarnings));
     }
   }
 
-  // Whether a group holds an object that reflects no light and does not glow (a csg: every
-  // operand), as placed by an instance without a material.
-  bool groupHasDarkObject(const GroupParts& group) const {
-    for (const Primitive& p : group.primitives) {
-      if (!isDark(p.emission(), p.materialIndex())) continue;
-      const Csg* csg = p.csg();
-      if (csg == nullptr ||
-          std::all_of(csg->tree->operands.begin(), csg->tree->operands.end(),
-                      [&](const CsgOperand& o) { return isDark(o.emission, o.materialIndex); })) {
-        return true;
-      }
+  // Reflects no light and does not glow (a csg: none of its operands).
+  bool isDarkPrimitive(const Primitive& p) const {
+    if (!isDark(p.emission(), p.materialIndex())) return false;
+    const Csg* csg = p.csg();
+    return csg == nullptr ||
+           std::all_of(csg->tree->operands.begin(), csg->tree->operands.end(),
+                       [&](const CsgOperand& o) { return isDark(o.emission, o.materialIndex); });
+  }
+
+  // Whether a group holds a shape written without a material that does not glow: dark wherever an
+  // instance gives it none.
+  bool groupHasObjectWithoutMaterial(const GroupParts& group) const {
+    for (std::size_t j = 0; j < group.primitives.size(); ++j) {
+      const bool takesMaterial =
+          j < group.primitiveTakesMaterial.size() && group.primitiveTakesMaterial[j] != 0;
+      if (takesMaterial && isDarkPrimitive(group.primitives[j])) return true;
     }
-    return std::any_of(group.meshes.begin(), group.meshes.end(),
-                       [&](const TriangleMesh& m) { return isDark(m.emission, m.materialIndex); });
+    return false;
   }
 
   static ValueId typeValue(const SourceFile& file, ValueId map) {
@@ -1040,10 +1070,18 @@ class Builder {
   std::vector<ObjectPlace> objectPlaces_;      // per primitive, where its object was written
   std::vector<std::string_view> objectTypes_;  // in the order messages list them
   std::vector<std::string_view> lightTypes_;
-  std::size_t enclosedLightWarnings_ = 0;
-  // Instances that give no material: where, and the group placed (warnAboutDarkObjects).
-  std::vector<std::pair<SourceLocation, std::uint32_t>>
-      bareInstances_;        // warnIfEnclosed: at most kMaxDarkObjectWarnings
+  // warnIfEnclosed: lights found inside an opaque solid, and where the first one not named is
+  // (the count of the rest is said there, as for dark objects).
+  std::size_t enclosedLights_ = 0;
+  std::optional<SourceLocation> firstUnnamedEnclosedLight_;
+  // Instances that give no material (warnAboutDarkObjects): where, the group placed, and how many
+  // primitives were built before them (their place in file order among the objects).
+  struct BareInstance {
+    SourceLocation where;
+    std::uint32_t group = 0;
+    std::size_t primitivesBefore = 0;
+  };
+  std::vector<BareInstance> bareInstances_;
   TextureLibrary textures_;  // the scene's textures; ctx_.textures points here
 };
 

@@ -818,9 +818,30 @@ TEST(SceneBuilder, AnInstanceOfAnUnlitGroupObjectIsAWarning) {
       "groups.yaml");
   ASSERT_EQ(loaded.warnings.size(), 1u);
   EXPECT_EQ(loaded.warnings[0].format(),
-            "groups.yaml:7:5: warning: instance of group 'ball': an object of the group reflects "
-            "no light (no material, and the instance gives none): under the lights it shows only "
-            "the ambient light (give the instance or the object a material with kd or ks)");
+            "groups.yaml:7:5: warning: instance of group 'ball': an object of the group has no "
+            "material and the instance gives none, so it reflects no light: under the lights it "
+            "shows only the ambient light (give the instance or the object a material with kd or "
+            "ks)");
+  // A group object with a black material of its own: an instance's material would not change it,
+  // so the instance is not blamed.
+  const LoadedScene own = loadSceneFromString(
+      std::string(kMinimal) +
+          "groups: {ball: [{type: sphere, center: [0, 0, -5], radius: 1, material: {ka: 0.5}}]}\n"
+          "objects: [{type: instance, group: ball}]\n"
+          "lights: [{type: point, position: [0, 0, 5]}]\n",
+      "own.yaml");
+  EXPECT_TRUE(own.warnings.empty());
+  // Instances and plain objects share the five named warnings and the count, in file order.
+  std::string mixed = std::string(kMinimal) +
+                      "groups: {ball: [{type: sphere, center: [0, 0, -5], radius: 1}]}\n"
+                      "lights: [{type: point, position: [0, 0, 5]}]\nobjects:\n";
+  for (int i = 0; i < 6; ++i) mixed += "  - {type: sphere, center: [0, 0, -5], radius: 1}\n";
+  mixed += "  - {type: instance, group: ball}\n";
+  const LoadedScene ordered = loadSceneFromString(mixed, "mixed.yaml");
+  ASSERT_EQ(ordered.warnings.size(), 6u);
+  EXPECT_EQ(ordered.warnings[4].format().substr(0, 23), "mixed.yaml:10:5: warnin");
+  EXPECT_EQ(ordered.warnings[5].format(),
+            "mixed.yaml:11:5: warning: 2 more objects reflect no light (this one first)");
   // Every instance of the group giving a material: none.
   const LoadedScene given =
       loadSceneFromString(std::string(kMinimal) +
@@ -875,6 +896,30 @@ TEST(SceneBuilder, ALightInsideAnOpaqueSolidIsAWarning) {
                        "{type: point, position: [0, 5, -5]}")
                   .empty());
   EXPECT_TRUE(warnings(bulb, "{type: point, position: [0, 1.5, -5]}").empty());
+  // A camera standing in the wall of a room (kMinimal's camera is at the origin) is inside.
+  EXPECT_TRUE(warnings("  - {type: box, min: [-9, -9, -9], max: [9, 9, 0], material: white}\n",
+                       "{type: point, position: [0, 5, -5]}")
+                  .empty());
+  // Past five such lights, one line counts the rest, at the first one not named.
+  std::string many;
+  for (int i = 0; i < 7; ++i) {
+    many += "  - {type: sphere, center: [" + std::to_string(3 * i) +
+            ", 0, -5], radius: 1, material: white}\n";
+  }
+  const LoadedScene lamps = loadSceneFromString(
+      std::string(kMinimal) + "materials: {white: {kd: 0.8}}\nobjects:\n" + many + "lights:\n" +
+          [] {
+            std::string lights;
+            for (int i = 0; i < 7; ++i) {
+              lights += "  - {type: point, position: [" + std::to_string(3 * i) + ", 0, -5]}\n";
+            }
+            return lights;
+          }(),
+      "lamps.yaml");
+  ASSERT_EQ(lamps.warnings.size(), 6u);
+  EXPECT_EQ(lamps.warnings[5].format(),
+            "lamps.yaml:18:5: warning: 2 more lights are inside opaque solids that do not hold the "
+            "camera (this one first)");
 }
 
 // ------------------------------------------------------------------------------------ mesh objects
