@@ -646,6 +646,36 @@ int parseFailure(const CLI::ParseError& error, const CLI::App& app, int argc, ch
   return kExitBadInput;
 }
 
+// An option taken as text, parsed later by parseRequest; value() is empty when it was not given.
+// Stays where it is once added (the parser writes into `text`).
+struct TextOption {
+  std::string text;
+  CLI::Option* option = nullptr;
+
+  void add(CLI::App& command, const std::string& name, const std::string& help,
+           const std::string& typeName) {
+    option = command.add_option(name, text, help)->type_name(typeName);
+  }
+  std::optional<std::string> value() const {
+    return option != nullptr && option->count() > 0 ? std::optional<std::string>(text)
+                                                    : std::nullopt;
+  }
+};
+
+// The options render and check share: what the scene is loaded and built with.
+struct SceneOptions {
+  TextOption width, height, samples, seed, integrator, maxMemory;
+
+  void readInto(RenderArgs& args) const {
+    args.width = width.value();
+    args.height = height.value();
+    args.samples = samples.value();
+    args.seed = seed.value();
+    args.integrator = integrator.value();
+    args.maxMemory = maxMemory.value();
+  }
+};
+
 int runCommandLine(int argc, char** argv) {
   CLI::App app{
       "glint: a ray tracer (Whitted's model, or path tracing). Renders scene files — YAML, NFF, "
@@ -667,64 +697,42 @@ int runCommandLine(int argc, char** argv) {
                        "default: the scene's name with .png, in the current folder")
           ->type_name("OUT");
   // Valued options are read as text and parsed by parseRequest (uniform messages, no wrap-around).
-  std::string width, height, samples, threads, seed, crop, integrator;
-  CLI::Option* widthOption =
-      render->add_option("--width", width, "Image width in pixels; alone it keeps the aspect")
-          ->type_name("W");
-  CLI::Option* heightOption =
-      render->add_option("--height", height, "Image height in pixels; alone it keeps the aspect")
-          ->type_name("H");
-  CLI::Option* samplesOption =
-      render->add_option("--samples", samples, "Samples per pixel, 1 to 65536")->type_name("N");
-  CLI::Option* threadsOption =
-      render->add_option("--threads", threads, "Worker threads (default: all cores)")
-          ->type_name("N");
-  CLI::Option* seedOption =
-      render->add_option("--seed", seed, "Random seed (replaces the scene's render.seed)")
-          ->type_name("S");
-  CLI::Option* integratorOption =
-      render
-          ->add_option("--integrator", integrator,
-                       "whitted or path (replaces the scene's render.integrator)")
-          ->type_name("NAME");
-  CLI::Option* cropOption =
-      render
-          ->add_option("--crop", crop,
-                       "Render only pixels X0 <= x < X1, Y0 <= y < Y1; the image is that region")
-          ->type_name("X0,Y0,X1,Y1");
-  std::string maxMemory, checkpoint, resume;
-  CLI::Option* maxMemoryOption =
-      render
-          ->add_option(
-              "--max-memory", maxMemory,
-              "Memory the scene may need (film, meshes, BVH, textures), e.g. 512M, 4G, 1.5GiB or "
-              "bytes; default: half the physical memory")
-          ->type_name("SIZE");
-  CLI::Option* checkpointOption =
-      render
-          ->add_option("--checkpoint", checkpoint,
-                       "Save finished tiles to FILE every few seconds and when interrupted; "
-                       "removed when the image is written")
-          ->type_name("FILE");
-  CLI::Option* resumeOption =
-      render
-          ->add_option("--resume", resume,
-                       "Continue the render saved in FILE (same scene and options), and keep "
-                       "checkpointing into it unless --checkpoint names another file")
-          ->type_name("FILE");
-  std::string isa;
-  CLI::Option* isaOption =
-      render
-          ->add_option("--isa", isa,
-                       "Instruction set of the BVH queries: baseline, avx2, avx512 or auto (the "
-                       "widest this processor runs; default, or GLINT_ISA); never changes a pixel")
-          ->type_name("ISA");
+  SceneOptions renderScene;
+  TextOption threads, crop, checkpoint, resume, isa;
+  renderScene.width.add(*render, "--width", "Image width in pixels; alone it keeps the aspect",
+                        "W");
+  renderScene.height.add(*render, "--height", "Image height in pixels; alone it keeps the aspect",
+                         "H");
+  renderScene.samples.add(*render, "--samples", "Samples per pixel, 1 to 65536", "N");
+  threads.add(*render, "--threads", "Worker threads (default: all cores)", "N");
+  renderScene.seed.add(*render, "--seed", "Random seed (replaces the scene's render.seed)", "S");
+  renderScene.integrator.add(*render, "--integrator",
+                             "whitted or path (replaces the scene's render.integrator)", "NAME");
+  crop.add(*render, "--crop",
+           "Render only pixels X0 <= x < X1, Y0 <= y < Y1; the image is that region",
+           "X0,Y0,X1,Y1");
+  renderScene.maxMemory.add(
+      *render, "--max-memory",
+      "Memory the scene may need (film, meshes, BVH, textures), e.g. 512M, 4G, 1.5GiB or bytes; "
+      "default: half the physical memory",
+      "SIZE");
+  checkpoint.add(*render, "--checkpoint",
+                 "Save finished tiles to FILE every few seconds and when interrupted; removed "
+                 "when the image is written",
+                 "FILE");
+  resume.add(*render, "--resume",
+             "Continue the render saved in FILE (same scene and options), and keep checkpointing "
+             "into it unless --checkpoint names another file",
+             "FILE");
+  isa.add(*render, "--isa",
+          "Instruction set of the BVH queries: baseline, avx2, avx512 or auto (the widest this "
+          "processor runs; default, or GLINT_ISA); never changes a pixel",
+          "ISA");
   render->add_flag("--quiet", args.quiet, "No progress and no summary; errors only");
   render->add_flag("--stats", args.stats, "More statistics at the end");
   const PreviewOptions previewOptions(*render);
 
-  std::string checkFile, checkMaxMemory, checkWidth, checkHeight, checkSamples, checkSeed,
-      checkIntegrator;
+  std::string checkFile;
   CLI::App* check =
       app.add_subcommand("check", "Parse and build a scene, print a summary; writes nothing");
   check->add_option("SCENE", checkFile, "Scene file (YAML, JSON, .nff, .dat, or a mesh file)")
@@ -732,22 +740,15 @@ int runCommandLine(int argc, char** argv) {
       ->type_name("FILE");
   // The memory estimate's refusals and the warnings render's options bring (a path integrator,
   // more samples) are among what check reports as render does.
-  CLI::Option* checkMaxMemoryOption =
-      check
-          ->add_option("--max-memory", checkMaxMemory,
-                       "Memory the scene may need, as for render (default: half the physical "
-                       "memory)")
-          ->type_name("SIZE");
-  CLI::Option* checkWidthOption =
-      check->add_option("--width", checkWidth, "As for render")->type_name("W");
-  CLI::Option* checkHeightOption =
-      check->add_option("--height", checkHeight, "As for render")->type_name("H");
-  CLI::Option* checkSamplesOption =
-      check->add_option("--samples", checkSamples, "As for render")->type_name("N");
-  CLI::Option* checkSeedOption =
-      check->add_option("--seed", checkSeed, "As for render")->type_name("S");
-  CLI::Option* checkIntegratorOption =
-      check->add_option("--integrator", checkIntegrator, "As for render")->type_name("NAME");
+  SceneOptions checkScene;
+  checkScene.maxMemory.add(
+      *check, "--max-memory",
+      "Memory the scene may need, as for render (default: half the physical memory)", "SIZE");
+  checkScene.width.add(*check, "--width", "As for render", "W");
+  checkScene.height.add(*check, "--height", "As for render", "H");
+  checkScene.samples.add(*check, "--samples", "As for render", "N");
+  checkScene.seed.add(*check, "--seed", "As for render", "S");
+  checkScene.integrator.add(*check, "--integrator", "As for render", "NAME");
 
   std::string convertFile, convertOutput;
   CLI::App* convert = app.add_subcommand(
@@ -799,20 +800,12 @@ int runCommandLine(int argc, char** argv) {
   if ((outputOption->count() > 0 && args.output.empty()) ||
       (convertOutputOption->count() > 0 && convertOutput.empty()))
     throw CliError(kExitBadInput, "-o needs a file name");
-  const auto given = [](const CLI::Option* option, const std::string& text) {
-    return option->count() > 0 ? std::optional<std::string>(text) : std::nullopt;
-  };
-  args.width = given(widthOption, width);
-  args.height = given(heightOption, height);
-  args.samples = given(samplesOption, samples);
-  args.threads = given(threadsOption, threads);
-  args.seed = given(seedOption, seed);
-  args.crop = given(cropOption, crop);
-  args.integrator = given(integratorOption, integrator);
-  args.maxMemory = given(maxMemoryOption, maxMemory);
-  args.checkpoint = given(checkpointOption, checkpoint);
-  args.resume = given(resumeOption, resume);
-  args.isa = given(isaOption, isa);
+  renderScene.readInto(args);
+  args.threads = threads.value();
+  args.crop = crop.value();
+  args.checkpoint = checkpoint.value();
+  args.resume = resume.value();
+  args.isa = isa.value();
   try {
     args.preview = previewOptions.request();
   } catch (const PreviewError& error) {
@@ -822,12 +815,7 @@ int runCommandLine(int argc, char** argv) {
   if (check->parsed()) {
     RenderArgs checkArgs;
     checkArgs.scene = checkFile;
-    checkArgs.maxMemory = given(checkMaxMemoryOption, checkMaxMemory);
-    checkArgs.width = given(checkWidthOption, checkWidth);
-    checkArgs.height = given(checkHeightOption, checkHeight);
-    checkArgs.samples = given(checkSamplesOption, checkSamples);
-    checkArgs.seed = given(checkSeedOption, checkSeed);
-    checkArgs.integrator = given(checkIntegratorOption, checkIntegrator);
+    checkScene.readInto(checkArgs);
     return runCheck(checkArgs);
   }
   SignalGuard signals;
