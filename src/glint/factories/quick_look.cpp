@@ -12,6 +12,7 @@
 #include "glint/core/bounds.h"
 #include "glint/mesh/format_checks.h"
 #include "glint/mesh/mesh_loader.h"
+#include "glint/readers/diagnostics.h"
 #include "glint/readers/text_statements.h"
 
 namespace glint {
@@ -42,14 +43,18 @@ void light(SceneEmitter& out, const Vec3& towardLight, double intensity) {
 
 }  // namespace
 
-std::string bareMeshFileHint(std::string_view refusal) {
+std::string bareMeshFileHint(std::string_view refusal, const std::filesystem::path& model) {
   if (refusal.find("may only name files in its own folder and below") == std::string_view::npos) {
     return {};
   }
-  return "; to use files outside the model's folder (a textures folder beside it), render a scene "
-         "file written in a folder that holds both, with a mesh object naming the model "
-         "(`objects: [{type: mesh, file: models/m.obj}]`, and a camera: glint convert cannot "
-         "write it, as it reads the model the same way)";
+  // The model as a scene file in the folder above its own would name it.
+  const std::filesystem::path folder = std::filesystem::absolute(model).parent_path().filename();
+  return fmt::format(
+      "; to use files outside the model's folder (a textures folder beside it), render a scene "
+      "file written in a folder that holds both, with a mesh object naming the model ({{type: "
+      "mesh, file: {}}}, and a camera: glint convert cannot write it, as it reads the model the "
+      "same way)",
+      escapeForMessage((folder / model.filename()).generic_string()));
 }
 
 bool isQuickLookFile(const std::filesystem::path& file) {
@@ -70,7 +75,7 @@ ParseResult describeQuickLook(const std::filesystem::path& file, const LoadOptio
     read = std::make_shared<const MeshFile>(
         readMeshFile(file, MeshReadOptions{.sceneFolder = {}, .cancel = options.cancel}));
   } catch (const MeshLoadError& e) {
-    const std::string reason = e.what() + bareMeshFileHint(e.what());
+    const std::string reason = e.what() + bareMeshFileHint(e.what(), file);
     // At the line and column in the file when the reason names them.
     if (const std::optional<MeshErrorPlace> place = meshErrorPlace(e.what())) {
       throw SceneError({{Diagnostic::Severity::Error,

@@ -18,9 +18,9 @@ namespace glint {
 // Whether `file`'s extension is a mesh file's (quick look).
 bool isQuickLookFile(const std::filesystem::path& file);
 
-// What to add to a refusal of a file a bare mesh file names outside its own folder: how to use
-// such a layout (a scene file above both); "" for any other reason.
-std::string bareMeshFileHint(std::string_view refusal);
+// What to add to a refusal of a file the bare mesh file `model` names outside its own folder: how
+// to use such a layout (a scene file above both, naming the model); "" for any other reason.
+std::string bareMeshFileHint(std::string_view refusal, const std::filesystem::path& model);
 
 // The quick-look scene of a mesh file, as entities (the mesh is read to find its bounds; a file
 // that cannot be read throws SceneError naming only the file).

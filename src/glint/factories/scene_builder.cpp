@@ -670,9 +670,9 @@ class Builder {
         scene = &fileMaterials(*file, path,
                                d_.bareMeshFile ? std::filesystem::path() : baseDirectory(params));
       } catch (const ImageReadError& e) {
-        params.error(params.place(),
-                     fmt::format("mesh file '{}': {}{}", shown, e.what(),
-                                 d_.bareMeshFile ? bareMeshFileHint(e.what()) : std::string()));
+        params.error(params.place(), fmt::format("mesh file '{}': {}{}", shown, e.what(),
+                                                 d_.bareMeshFile ? bareMeshFileHint(e.what(), path)
+                                                                 : std::string()));
         return;
       }
     }
