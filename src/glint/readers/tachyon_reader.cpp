@@ -203,13 +203,7 @@ class TachyonReader {
         // VMD writes FOCALDIST, Tachyon's manual FOCALLENGTH: both are the first value of
         // Tachyon's rt_camera_dof (the distance in focus), APERTURE its second (the f-number).
         c.depthOfField = mode.at;
-        const Token focal = in_.need(t, "FOCALDIST");
-        const std::string f = upper(focal.text);
-        if (f != "FOCALDIST" && f != "FOCALLENGTH") {
-          out_.error(focal.at, fmt::format("{}: expected FOCALDIST or FOCALLENGTH, got {}", t.text,
-                                           quoteForMessage(focal.text)));
-          throw SyntaxError{};
-        }
+        in_.expectEither(t, in_.need(t, "FOCALDIST"), "FOCALDIST", "FOCALLENGTH");
         c.focalDistance = in_.number(t, "focal distance");
         in_.keyword(t, "APERTURE");
         c.fNumber = in_.number(t, "aperture");
@@ -375,12 +369,7 @@ class TachyonReader {
   // same blend). It replaces BACKGROUND's colour wherever it is written.
   void backgroundGradient(const Token& t) {
     const Token kind = in_.need(t, "SKY_SPHERE or SKY_ORTHO_PLANE");
-    const std::string k = upper(kind.text);
-    if (k != "SKY_SPHERE" && k != "SKY_ORTHO_PLANE") {
-      out_.error(kind.at, fmt::format("{}: expected SKY_SPHERE or SKY_ORTHO_PLANE, got {}", t.text,
-                                      quoteForMessage(kind.text)));
-      throw SyntaxError{};
-    }
+    const std::string k = in_.expectEither(t, kind, "SKY_SPHERE", "SKY_ORTHO_PLANE");
     Gradient g;
     g.at = t.at;
     g.kindAt = kind.at;

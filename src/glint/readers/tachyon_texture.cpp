@@ -37,6 +37,17 @@ void Input::expectWord(const Token& statement, const Token& got, std::string_vie
   }
 }
 
+std::string Input::expectEither(const Token& statement, const Token& got, std::string_view first,
+                                std::string_view second) {
+  std::string word = upper(got.text);
+  if (word != first && word != second) {
+    out_.error(got.at, fmt::format("{}: expected {} or {}, got {}", statement.text, first, second,
+                                   quoteForMessage(got.text)));
+    throw SyntaxError{};
+  }
+  return word;
+}
+
 void Input::keyword(const Token& statement, std::string_view word) {
   expectWord(statement, need(statement, word), word);
 }

@@ -41,6 +41,9 @@ class Input {
   // The next token must be `word` (any case).
   void keyword(const Token& statement, std::string_view word);
   void expectWord(const Token& statement, const Token& got, std::string_view word);
+  // `got` must be `first` or `second` (any case); returns it in upper case.
+  std::string expectEither(const Token& statement, const Token& got, std::string_view first,
+                           std::string_view second);
   Number number(const Token& statement, std::string_view what);
   // x, y, z of a point, vector or normal, mirrored in x (tachyon_reader.h).
   Triple point(const Token& statement, std::string_view what);
